@@ -1,0 +1,53 @@
+"""The ``linecrew`` console script: one command, a subcommand per tool.
+
+Each subcommand lives in the package that owns it and is imported only when
+called, so ``linecrew router`` never loads the planner or FastAPI.
+"""
+
+from __future__ import annotations
+
+import importlib
+import sys
+
+# name -> ("module:function", help). The function takes argv and returns an exit code.
+COMMANDS: dict[str, tuple[str, str]] = {
+    "router": ("ground_station.router:main", "run the ground site's Zenoh router"),
+}
+BENCHES: dict[str, tuple[str, str]] = {
+    "bus": ("linecrew.bus.bench:main", "Zenoh bus latency, throughput, liveliness"),
+}
+
+
+def _usage() -> str:
+    lines = ["usage: linecrew COMMAND [ARGS...]", "", "commands:"]
+    lines += [f"  {name:<16}{help_}" for name, (_, help_) in COMMANDS.items()]
+    lines += [f"  bench {name:<10}{help_}" for name, (_, help_) in BENCHES.items()]
+    lines += ["", "Run 'linecrew COMMAND --help' for a command's options."]
+    return "\n".join(lines)
+
+
+def _run(target: str, argv: list[str]) -> int:
+    module_name, function_name = target.split(":")
+    function = getattr(importlib.import_module(module_name), function_name)
+    return int(function(argv) or 0)
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Dispatch ``linecrew COMMAND ...``; exit code 2 for an unknown command."""
+    args = sys.argv[1:] if argv is None else argv
+    if not args or args[0] in {"-h", "--help", "help"}:
+        print(_usage())
+        return 0 if args else 2
+    name, rest = args[0], args[1:]
+    if name == "bench":
+        table, name, rest = BENCHES, (rest[0] if rest else ""), rest[1:]
+    else:
+        table = COMMANDS
+    if name not in table:
+        print(f"linecrew: unknown command {' '.join(args[:2])!r}\n\n{_usage()}", file=sys.stderr)
+        return 2
+    return _run(table[name][0], rest)
+
+
+if __name__ == "__main__":
+    sys.exit(main())

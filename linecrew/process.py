@@ -1,0 +1,87 @@
+"""What every long-running linecrew process shares: common command-line
+flags, the bus settings they imply, and shutdown on SIGINT/SIGTERM."""
+
+from __future__ import annotations
+
+import argparse
+import asyncio
+import contextlib
+import signal
+import threading
+
+from linecrew.bus import BusConfig
+from linecrew.logs import configure_logging
+
+
+def common_parser(prog: str, description: str) -> argparse.ArgumentParser:
+    """An argument parser with the flags every process takes."""
+    parser = argparse.ArgumentParser(prog=prog, description=description)
+    parser.add_argument("--site", default="default", help="site id (key space root)")
+    parser.add_argument(
+        "--connect", action="append", help="zenoh endpoint to connect to (repeatable)"
+    )
+    parser.add_argument("--listen", action="append", help="zenoh endpoint to listen on")
+    parser.add_argument("--zenoh-config", help="a zenoh json5 config file applied first")
+    parser.add_argument("--lease-ms", type=int, help="zenoh transport lease (ms)")
+    parser.add_argument("--log-level", default="info", help="debug, info, warning, error")
+    parser.add_argument("--log-format", choices=["plain", "json"], default="plain")
+    return parser
+
+
+def start(args: argparse.Namespace, process: str, mode: str = "client") -> BusConfig:
+    """Configure logging for ``process`` and return its bus settings
+    (flags override ``LINECREW_ZENOH_*`` environment variables)."""
+    configure_logging(args.log_level, args.log_format, process)
+    return BusConfig.from_env(
+        mode=mode,
+        connect=tuple(args.connect) if args.connect else None,
+        listen=tuple(args.listen) if args.listen else None,
+        config_file=args.zenoh_config,
+        lease_ms=args.lease_ms,
+    )
+
+
+class Shutdown:
+    """Set when SIGINT or SIGTERM arrives; usable from threads and asyncio."""
+
+    SIGNALS = (signal.SIGINT, signal.SIGTERM)
+
+    def __init__(self) -> None:
+        self._event = threading.Event()
+        self._loop: asyncio.AbstractEventLoop | None = None
+        self._async_event: asyncio.Event | None = None
+        self.signal_name = ""
+
+    def install(self) -> Shutdown:
+        """Install the handlers (main thread only)."""
+        for sig in self.SIGNALS:
+            signal.signal(sig, self._on_signal)
+        return self
+
+    def _on_signal(self, signum: int, _frame: object) -> None:
+        self.signal_name = signal.Signals(signum).name
+        self.request()
+
+    def is_set(self) -> bool:
+        """Whether shutdown was requested."""
+        return self._event.is_set()
+
+    def request(self) -> None:
+        """Ask for shutdown from code (e.g. a fatal error in a component)."""
+        self._event.set()
+        if self._loop is not None and self._async_event is not None:
+            with contextlib.suppress(RuntimeError):  # loop already closed
+                self._loop.call_soon_threadsafe(self._async_event.set)
+
+    def wait(self, timeout_s: float | None = None) -> bool:
+        """Block until shutdown is requested (or the timeout passes)."""
+        return self._event.wait(timeout_s)
+
+    async def wait_async(self) -> None:
+        """Await shutdown from the running event loop."""
+        if self._async_event is None:
+            self._loop = asyncio.get_running_loop()
+            self._async_event = asyncio.Event()
+            if self._event.is_set():
+                self._async_event.set()
+        await self._async_event.wait()

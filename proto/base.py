@@ -1,0 +1,43 @@
+"""Base classes and constrained scalar types for wire structs."""
+
+from __future__ import annotations
+
+from typing import Annotated
+
+import msgspec
+
+SCHEMA_VERSION = 1
+"""Schema version written into every top-level message."""
+
+MIN_SCHEMA_VERSION = 1
+"""Oldest schema version this code still decodes."""
+
+Fraction = Annotated[float, msgspec.Meta(ge=0.0, le=1.0, description="fraction 0..1")]
+NonNegative = Annotated[float, msgspec.Meta(ge=0.0)]
+Positive = Annotated[float, msgspec.Meta(gt=0.0)]
+Count = Annotated[int, msgspec.Meta(ge=0)]
+PositiveCount = Annotated[int, msgspec.Meta(ge=1)]
+ID_PATTERN = r"^[A-Za-z0-9._-]{1,64}$"
+"""An id is one key-expression chunk: safe in every key of :mod:`proto.keys`."""
+
+Id = Annotated[
+    str,
+    msgspec.Meta(
+        pattern=ID_PATTERN,
+        description="one key-expression chunk of [A-Za-z0-9._-]",
+    ),
+]
+
+
+class Record(msgspec.Struct, frozen=True, kw_only=True, forbid_unknown_fields=False):
+    """A value nested inside a message (no schema version of its own)."""
+
+
+class Message(Record, frozen=True, kw_only=True):
+    """A top-level wire message: carries ``schema_version``.
+
+    Schema evolution rule: new fields get defaults and go at the end; a
+    field's type never changes.
+    """
+
+    schema_version: int = SCHEMA_VERSION

@@ -1,0 +1,34 @@
+"""Ground-station events, published on ``gs/events`` and kept in history."""
+
+from __future__ import annotations
+
+import enum
+
+from proto.base import Count, Id, Message
+
+
+class EventKind(enum.StrEnum):
+    """What happened."""
+
+    ACTION_ACCEPTED = "action_accepted"
+    ACTION_CHANGED = "action_changed"
+    ACTION_CANCELLED = "action_cancelled"
+    ACTION_STATE = "action_state"
+    PLAN_CHANGED = "plan_changed"
+    REPLAN = "replan"
+    UAV_LOST = "uav_lost"
+    UAV_BACK = "uav_back"
+    UAV_STATE = "uav_state"
+    FAULT = "fault"
+
+
+class GsEvent(Message, frozen=True, kw_only=True):
+    """One event. ``seq`` increases by one per event of a ground station."""
+
+    seq: Count
+    stamp_s: float
+    kind: EventKind
+    action_id: Id | None = None
+    uav_id: Id | None = None
+    epoch: Count | None = None
+    detail: str = ""

@@ -1,0 +1,65 @@
+"""Geometry: local ENU metres around a geodetic site origin, and WGS84.
+
+The conversion uses :mod:`pymap3d` (ENU <-> geodetic on the WGS84
+ellipsoid): exact at kilometre scale, which a flat-earth shortcut is not for
+a power-line corridor several kilometres long.
+"""
+
+from __future__ import annotations
+
+import math
+
+import pymap3d
+
+from proto.base import Record
+
+
+class Point(Record, frozen=True, kw_only=True):
+    """A point in the site's local frame: x east, y north, z up, metres."""
+
+    x_m: float
+    y_m: float
+    z_m: float = 0.0
+
+    def distance_to(self, other: Point) -> float:
+        """Euclidean distance in metres."""
+        return math.dist((self.x_m, self.y_m, self.z_m), (other.x_m, other.y_m, other.z_m))
+
+
+class Vector(Record, frozen=True, kw_only=True):
+    """A velocity in the local frame, metres per second (east, north, up)."""
+
+    east_mps: float = 0.0
+    north_mps: float = 0.0
+    up_mps: float = 0.0
+
+
+class GeoPoint(Record, frozen=True, kw_only=True):
+    """A WGS84 position: degrees, and metres above the ellipsoid."""
+
+    lat_deg: float = 0.0
+    lon_deg: float = 0.0
+    alt_m: float = 0.0
+
+
+class LocalFrame:
+    """Converts between the site's local ENU frame and WGS84 around ``origin``."""
+
+    def __init__(self, origin: GeoPoint) -> None:
+        self.origin = origin
+
+    def to_geodetic(self, point: Point) -> GeoPoint:
+        """Local ENU metres -> WGS84 (degrees, metres)."""
+        o = self.origin
+        lat, lon, alt = pymap3d.enu2geodetic(
+            point.x_m, point.y_m, point.z_m, o.lat_deg, o.lon_deg, o.alt_m
+        )
+        return GeoPoint(lat_deg=float(lat), lon_deg=float(lon), alt_m=float(alt))
+
+    def to_local(self, geo: GeoPoint) -> Point:
+        """WGS84 (degrees, metres) -> local ENU metres."""
+        o = self.origin
+        x, y, z = pymap3d.geodetic2enu(
+            geo.lat_deg, geo.lon_deg, geo.alt_m, o.lat_deg, o.lon_deg, o.alt_m
+        )
+        return Point(x_m=float(x), y_m=float(y), z_m=float(z))

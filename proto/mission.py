@@ -1,0 +1,78 @@
+"""Operator actions (what the crew asks for) and their lifecycle records."""
+
+from __future__ import annotations
+
+import enum
+
+from proto.base import Fraction, Id, NonNegative, Positive, PositiveCount, Record
+from proto.geo import Point
+
+
+class ActionBase(Record, frozen=True, kw_only=True):
+    """Fields every action has.
+
+    ``priority`` is the weight of the FCFS queue (higher first);
+    ``release_s`` is the earliest start (UNIX seconds, 0 = now).
+    """
+
+    priority: Positive = 1.0
+    release_s: NonNegative = 0.0
+
+
+class WaypointSpec(Record, frozen=True, kw_only=True):
+    """One point to inspect and how long to hold there (seconds)."""
+
+    position: Point
+    service_s: NonNegative = 0.0
+
+
+class InspectAction(ActionBase, frozen=True, kw_only=True, tag="inspect"):
+    """Inspect ``waypoints``; the planner may split them among UAVs."""
+
+    waypoints: list[WaypointSpec]
+
+
+class MonitorAction(ActionBase, frozen=True, kw_only=True, tag="monitor"):
+    """Watch ``worker_id`` with ``uavs`` UAVs at ``standoff_m`` for ``duration_s``."""
+
+    worker_id: Id
+    uavs: PositiveCount = 1
+    standoff_m: Positive = 5.0
+    duration_s: Positive
+
+
+class DeliverAction(ActionBase, frozen=True, kw_only=True, tag="deliver"):
+    """Bring ``tool`` from ``tool_station_id`` to ``worker_id``."""
+
+    tool: Id
+    tool_station_id: Id
+    worker_id: Id
+    pick_s: NonNegative = 5.0
+    drop_s: NonNegative = 5.0
+
+
+Action = InspectAction | MonitorAction | DeliverAction
+
+
+class ActionState(enum.StrEnum):
+    """Lifecycle of an action at the ground station."""
+
+    ACCEPTED = "accepted"
+    PLANNED = "planned"
+    IN_PROGRESS = "in_progress"
+    COMPLETED = "completed"
+    FAILED = "failed"
+    CANCELLED = "cancelled"
+
+
+class ActionRecord(Record, frozen=True, kw_only=True):
+    """An action as the ground station holds it."""
+
+    action_id: Id
+    action: Action
+    state: ActionState
+    progress: Fraction = 0.0
+    created_s: float = 0.0
+    updated_s: float = 0.0
+    reason: str = ""
+    request_id: str | None = None

@@ -1,0 +1,98 @@
+"""Plans sent from the ground station to each agent.
+
+A :class:`Plan` holds the ordered tasks of one UAV under a monotonically
+increasing ``epoch``; an agent ignores any plan older than the one it holds.
+Every task carries the planner's estimates (``start_s``/``end_s`` in UNIX
+seconds, ``energy_after_wh``) so agents can judge "battery enough".
+"""
+
+from __future__ import annotations
+
+from proto.base import Count, Fraction, Id, Message, NonNegative, Positive, PositiveCount, Record
+from proto.geo import Point
+
+
+class TaskBase(Record, frozen=True, kw_only=True):
+    """Fields every task has."""
+
+    task_id: Id
+    action_id: Id | None = None
+    start_s: float = 0.0
+    end_s: float = 0.0
+    energy_after_wh: float = 0.0
+
+
+class Waypoint(Record, frozen=True, kw_only=True):
+    """An inspection point: fly there, hold ``service_s`` seconds.
+    ``index`` is its position in the action's original waypoint list."""
+
+    index: Count
+    position: Point
+    service_s: NonNegative = 0.0
+
+
+class InspectTask(TaskBase, frozen=True, kw_only=True, tag="inspect"):
+    """Visit ``waypoints`` in order."""
+
+    waypoints: list[Waypoint]
+
+
+class MonitorTask(TaskBase, frozen=True, kw_only=True, tag="monitor"):
+    """Hold slot ``slot`` of ``slots`` around the worker at ``standoff_m``,
+    following them, for ``duration_s``."""
+
+    worker_id: Id
+    slot: Count
+    slots: PositiveCount
+    standoff_m: Positive
+    duration_s: Positive
+
+
+class PickTask(TaskBase, frozen=True, kw_only=True, tag="pick"):
+    """Fly to a tool station and grab ``tool`` (takes ``pick_s``)."""
+
+    tool: Id
+    tool_station_id: Id
+    position: Point
+    pick_s: NonNegative = 0.0
+
+
+class DeliverTask(TaskBase, frozen=True, kw_only=True, tag="deliver"):
+    """Fly to the worker and release the held ``tool`` (takes ``drop_s``)."""
+
+    tool: Id
+    worker_id: Id
+    drop_s: NonNegative = 0.0
+
+
+class RechargeTask(TaskBase, frozen=True, kw_only=True, tag="recharge"):
+    """Land on a pad of ``station_id`` and stay until ``until_fraction``."""
+
+    station_id: Id
+    position: Point
+    until_fraction: Fraction = 0.95
+
+
+class WaitTask(TaskBase, frozen=True, kw_only=True, tag="wait"):
+    """Hold (on the pad if landed) until ``until_s`` (UNIX seconds)."""
+
+    until_s: float
+
+
+class GoHomeTask(TaskBase, frozen=True, kw_only=True, tag="home"):
+    """Fly to ``station_id`` and land."""
+
+    station_id: Id
+    position: Point
+
+
+Task = InspectTask | MonitorTask | PickTask | DeliverTask | RechargeTask | WaitTask | GoHomeTask
+
+
+class Plan(Message, frozen=True, kw_only=True):
+    """The task list of one UAV, on ``uav/{id}/plan``."""
+
+    uav_id: Id
+    epoch: Count
+    issued_s: float = 0.0
+    tasks: list[Task] = []

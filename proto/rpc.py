@@ -1,0 +1,162 @@
+"""RPC between the gateway / CLI and the ground station.
+
+Each request is sent as a Zenoh query on ``gs/rpc/{request.op}`` and answered
+with one :data:`Reply`; failures come back as :class:`ErrorReply` (code,
+message, offending field). State-changing requests carry a client
+``request_id`` and are idempotent on it.
+"""
+
+from __future__ import annotations
+
+import enum
+import typing
+from typing import ClassVar
+
+from proto.base import Count, Id, Message, Positive, PositiveCount, Record
+from proto.events import GsEvent
+from proto.mission import Action, ActionRecord, ActionState
+from proto.plan import Plan
+from proto.telemetry import AgentStatus, Telemetry
+
+
+class RequestBase(Message, frozen=True, kw_only=True):
+    """Fields and the routing name (``op``) every request has."""
+
+    op: ClassVar[str]
+
+
+class SubmitAction(RequestBase, frozen=True, kw_only=True, tag="submit"):
+    """Add an action. Replies :class:`ActionReply`."""
+
+    op = "submit"
+    request_id: str
+    action: Action
+
+
+class ModifyAction(RequestBase, frozen=True, kw_only=True, tag="modify"):
+    """Change an action's priority and/or parameters (same kind). Replies
+    :class:`ActionReply`."""
+
+    op = "modify"
+    request_id: str
+    action_id: Id
+    priority: Positive | None = None
+    action: Action | None = None
+
+
+class CancelAction(RequestBase, frozen=True, kw_only=True, tag="cancel"):
+    """Cancel an action. Replies :class:`ActionReply`."""
+
+    op = "cancel"
+    request_id: str
+    action_id: Id
+
+
+class GetAction(RequestBase, frozen=True, kw_only=True, tag="get_action"):
+    """One action. Replies :class:`ActionReply`."""
+
+    op = "get_action"
+    action_id: Id
+
+
+class ListActions(RequestBase, frozen=True, kw_only=True, tag="list_actions"):
+    """Actions, optionally only those in ``states``. Replies :class:`ActionList`."""
+
+    op = "list_actions"
+    states: list[ActionState] = []
+
+
+class GetFleet(RequestBase, frozen=True, kw_only=True, tag="fleet"):
+    """The fleet's state. Replies :class:`FleetReply`."""
+
+    op = "fleet"
+
+
+class GetPlans(RequestBase, frozen=True, kw_only=True, tag="plans"):
+    """Current plans (of one UAV if ``uav_id``). Replies :class:`PlansReply`."""
+
+    op = "plans"
+    uav_id: Id | None = None
+
+
+class GetHistory(RequestBase, frozen=True, kw_only=True, tag="history"):
+    """Events with ``seq > after_seq``, oldest first. Replies :class:`HistoryReply`."""
+
+    op = "history"
+    after_seq: Count = 0
+    limit: PositiveCount = 100
+
+
+Request = (
+    SubmitAction
+    | ModifyAction
+    | CancelAction
+    | GetAction
+    | ListActions
+    | GetFleet
+    | GetPlans
+    | GetHistory
+)
+REQUEST_OPS: tuple[str, ...] = tuple(t.op for t in typing.get_args(Request))
+"""The routing names of all requests, one queryable each."""
+
+
+class UavOpState(enum.StrEnum):
+    """A UAV's state as operators see it."""
+
+    IDLE = "idle"
+    BUSY = "busy"
+    RECHARGING = "recharging"
+    EMERGENCY = "emergency"
+    LOST = "lost"
+    FAILED = "failed"
+
+
+class UavState(Record, frozen=True, kw_only=True):
+    """One UAV in a :class:`FleetReply`: state plus its latest reports."""
+
+    uav_id: Id
+    state: UavOpState
+    telemetry: Telemetry | None = None
+    status: AgentStatus | None = None
+
+
+class ActionReply(Message, frozen=True, kw_only=True, tag="action"):
+    """One action record."""
+
+    record: ActionRecord
+
+
+class ActionList(Message, frozen=True, kw_only=True, tag="actions"):
+    """Action records."""
+
+    records: list[ActionRecord]
+
+
+class FleetReply(Message, frozen=True, kw_only=True, tag="fleet"):
+    """Every UAV's state."""
+
+    uavs: list[UavState]
+
+
+class PlansReply(Message, frozen=True, kw_only=True, tag="plans"):
+    """Current plans."""
+
+    plans: list[Plan]
+
+
+class HistoryReply(Message, frozen=True, kw_only=True, tag="history"):
+    """Events, oldest first."""
+
+    events: list[GsEvent]
+
+
+class ErrorReply(Message, frozen=True, kw_only=True, tag="error"):
+    """A typed failure: stable ``code``, human ``message``, offending ``field``."""
+
+    code: str
+    message: str
+    field: str | None = None
+
+
+Reply = ActionReply | ActionList | FleetReply | PlansReply | HistoryReply | ErrorReply

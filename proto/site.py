@@ -1,0 +1,108 @@
+"""The site description shared by the ground station and the simulator:
+geodetic origin, towers and lines, charging stations with pads, tool
+stations, workers. Positions are local ENU metres (see :mod:`proto.geo`).
+"""
+
+from __future__ import annotations
+
+from proto.base import Count, Id, Message, NonNegative, Positive, Record
+from proto.geo import GeoPoint, Point
+
+
+class Tower(Record, frozen=True, kw_only=True):
+    """A transmission tower; ``position`` is its top (where the wires hang)."""
+
+    id: Id
+    position: Point
+
+
+class Line(Record, frozen=True, kw_only=True):
+    """A power line strung through ``tower_ids`` in order."""
+
+    id: Id
+    tower_ids: list[Id]
+
+
+class BatterySwap(Record, frozen=True, kw_only=True, tag="swap"):
+    """Recharge by swapping the pack: always ``swap_s`` seconds."""
+
+    swap_s: NonNegative
+
+
+class Charging(Record, frozen=True, kw_only=True, tag="charge"):
+    """Recharge on a pad: ``full_charge_s`` seconds from empty to full,
+    proportional to the missing energy."""
+
+    full_charge_s: Positive
+
+
+RechargeModel = BatterySwap | Charging
+
+
+class ChargingStation(Record, frozen=True, kw_only=True):
+    """Landing pads where UAVs recharge; at most ``pads`` at once."""
+
+    id: Id
+    position: Point
+    pads: Count = 1
+    recharge: RechargeModel = Charging(full_charge_s=1800.0)
+
+
+class Tool(Record, frozen=True, kw_only=True):
+    """A tool a gripper UAV can carry."""
+
+    name: Id
+    mass_kg: NonNegative = 0.0
+
+
+class ToolStation(Record, frozen=True, kw_only=True):
+    """A pick-up point holding tools."""
+
+    id: Id
+    position: Point
+    tools: list[Tool] = []
+
+
+class Worker(Record, frozen=True, kw_only=True):
+    """A human worker; ``position`` is where they start (the tracker moves them)."""
+
+    id: Id
+    position: Point
+
+
+class Site(Message, frozen=True, kw_only=True):
+    """Everything static about a work site."""
+
+    id: Id = "default"
+    origin: GeoPoint
+    towers: list[Tower] = []
+    lines: list[Line] = []
+    stations: list[ChargingStation] = []
+    tool_stations: list[ToolStation] = []
+    workers: list[Worker] = []
+
+    def station(self, station_id: str) -> ChargingStation | None:
+        """The charging station with this id, if any."""
+        return next((s for s in self.stations if s.id == station_id), None)
+
+    def tool_station(self, station_id: str) -> ToolStation | None:
+        """The tool station with this id, if any."""
+        return next((s for s in self.tool_stations if s.id == station_id), None)
+
+    def worker(self, worker_id: str) -> Worker | None:
+        """The worker with this id, if any."""
+        return next((w for w in self.workers if w.id == worker_id), None)
+
+
+__all__ = [
+    "BatterySwap",
+    "Charging",
+    "ChargingStation",
+    "Line",
+    "RechargeModel",
+    "Site",
+    "Tool",
+    "ToolStation",
+    "Tower",
+    "Worker",
+]

@@ -1,0 +1,103 @@
+"""Start real linecrew processes for integration tests and stop them for sure."""
+
+from __future__ import annotations
+
+import contextlib
+import os
+import signal
+import socket
+import subprocess
+import sys
+import tempfile
+import time
+from collections.abc import Callable, Iterator
+
+
+def free_port() -> int:
+    """A TCP port free on 127.0.0.1 right now."""
+    with socket.socket() as sock:
+        sock.bind(("127.0.0.1", 0))
+        return sock.getsockname()[1]
+
+
+def wait_until(predicate: Callable[[], object], timeout_s: float = 10.0, what: str = "") -> None:
+    """Poll ``predicate`` until it is truthy; fail the test after ``timeout_s``."""
+    deadline = time.monotonic() + timeout_s
+    while not predicate():
+        if time.monotonic() > deadline:
+            raise AssertionError(f"timed out after {timeout_s} s waiting for {what or predicate}")
+        time.sleep(0.01)
+
+
+def port_open(port: int) -> bool:
+    """Whether something accepts TCP connections on 127.0.0.1:port."""
+    with socket.socket() as sock:
+        sock.settimeout(0.2)
+        return sock.connect_ex(("127.0.0.1", port)) == 0
+
+
+class Process:
+    """A child process in its own session, its output captured to a file."""
+
+    def __init__(self, args: list[str], name: str) -> None:
+        self.name = name
+        fd, self.log_path = tempfile.mkstemp(prefix=f"{name}-", suffix=".log")
+        env = dict(os.environ, PYTHONUNBUFFERED="1")
+        with os.fdopen(fd, "wb") as log:
+            self.popen = subprocess.Popen(
+                args, stdout=log, stderr=subprocess.STDOUT, start_new_session=True, env=env
+            )
+
+    def output(self) -> str:
+        """Everything the process printed so far."""
+        with open(self.log_path, errors="replace") as handle:
+            return handle.read()
+
+    def stop(self, timeout_s: float = 10.0) -> int:
+        """SIGTERM, then SIGKILL to the group after ``timeout_s``; the exit code."""
+        if self.popen.poll() is None:
+            with contextlib.suppress(ProcessLookupError):
+                os.killpg(self.popen.pid, signal.SIGTERM)
+            try:
+                self.popen.wait(timeout_s)
+            except subprocess.TimeoutExpired:
+                with contextlib.suppress(ProcessLookupError):
+                    os.killpg(self.popen.pid, signal.SIGKILL)
+                self.popen.wait()
+        return self.popen.returncode
+
+    def kill(self) -> None:
+        """SIGKILL the group now."""
+        with contextlib.suppress(ProcessLookupError):
+            os.killpg(self.popen.pid, signal.SIGKILL)
+        self.popen.wait()
+
+
+@contextlib.contextmanager
+def running(args: list[str], name: str, ready: Callable[[], object]) -> Iterator[Process]:
+    """Run a process until the block ends; wait for ``ready()`` first; print
+    its log if anything fails."""
+    proc = Process(args, name)
+    try:
+        wait_until(lambda: ready() or proc.popen.poll() is not None, 20.0, f"{name} ready")
+        if proc.popen.poll() is not None:
+            raise AssertionError(f"{name} exited with {proc.popen.returncode}")
+        yield proc
+    except BaseException:
+        proc.stop()
+        sys.stderr.write(f"--- {name} log ---\n{proc.output()}\n")
+        raise
+    finally:
+        proc.stop()
+
+
+def router_args(port: int, *extra: str) -> list[str]:
+    """Command line of a router listening on 127.0.0.1:port."""
+    return [
+        sys.executable,
+        "-m",
+        "ground_station.router",
+        "--listen",
+        f"tcp/127.0.0.1:{port}",
+        *extra,
+    ]
