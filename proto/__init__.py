@@ -60,6 +60,7 @@ from proto.rpc import (
     UavOpState,
     UavState,
 )
+from proto.scenario import Scenario, ScriptedAction
 from proto.sim import BatteryFault, GpsFreeze, LinkDrop, MotorFailure, SimFault
 from proto.site import (
     BatterySwap,
@@ -149,6 +150,8 @@ __all__ = [
     "RequestError",
     "RequestTimeout",
     "Role",
+    "Scenario",
+    "ScriptedAction",
     "SimFault",
     "Site",
     "SubmitAction",
