@@ -12,9 +12,12 @@ import sys
 # name -> ("module:function", help). The function takes argv and returns an exit code.
 COMMANDS: dict[str, tuple[str, str]] = {
     "router": ("ground_station.router:main", "run the ground site's Zenoh router"),
+    "ground-station": ("ground_station.main:main", "run the mission manager and planner"),
+    "sim": ("sim_fleet.main:main", "run the MAVLink fleet simulator and human tracker"),
 }
 BENCHES: dict[str, tuple[str, str]] = {
     "bus": ("linecrew.bus.bench:main", "Zenoh bus latency, throughput, liveliness"),
+    "ground-station": ("ground_station.bench:main", "event-to-plan latency, loss detection"),
 }
 
 

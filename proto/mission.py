@@ -66,7 +66,12 @@ class ActionState(enum.StrEnum):
 
 
 class ActionRecord(Record, frozen=True, kw_only=True):
-    """An action as the ground station holds it."""
+    """An action as the ground station holds it.
+
+    Partial progress: ``waypoints_done`` (inspection waypoint indices already
+    inspected, so a split inspection resumes) and ``monitored_s`` (seconds of
+    monitoring already covered).
+    """
 
     action_id: Id
     action: Action
@@ -76,3 +81,5 @@ class ActionRecord(Record, frozen=True, kw_only=True):
     updated_s: float = 0.0
     reason: str = ""
     request_id: str | None = None
+    waypoints_done: list[int] = []
+    monitored_s: NonNegative = 0.0

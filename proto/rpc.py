@@ -31,6 +31,7 @@ class SubmitAction(RequestBase, frozen=True, kw_only=True, tag="submit"):
     op = "submit"
     request_id: str
     action: Action
+    action_id: Id | None = None  # a client-chosen id (else the ground station assigns one)
 
 
 class ModifyAction(RequestBase, frozen=True, kw_only=True, tag="modify"):
@@ -87,6 +88,12 @@ class GetHistory(RequestBase, frozen=True, kw_only=True, tag="history"):
     limit: PositiveCount = 100
 
 
+class GetMetrics(RequestBase, frozen=True, kw_only=True, tag="metrics"):
+    """The ground station's counters and timings. Replies :class:`MetricsReply`."""
+
+    op = "metrics"
+
+
 Request = (
     SubmitAction
     | ModifyAction
@@ -96,6 +103,7 @@ Request = (
     | GetFleet
     | GetPlans
     | GetHistory
+    | GetMetrics
 )
 REQUEST_OPS: tuple[str, ...] = tuple(t.op for t in typing.get_args(Request))
 """The routing names of all requests, one queryable each."""
@@ -159,4 +167,12 @@ class ErrorReply(Message, frozen=True, kw_only=True, tag="error"):
     field: str | None = None
 
 
-Reply = ActionReply | ActionList | FleetReply | PlansReply | HistoryReply | ErrorReply
+class MetricsReply(Message, frozen=True, kw_only=True, tag="metrics"):
+    """Named numbers (counts, seconds) of the ground station."""
+
+    values: dict[str, float]
+
+
+Reply = (
+    ActionReply | ActionList | FleetReply | PlansReply | HistoryReply | MetricsReply | ErrorReply
+)

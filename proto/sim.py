@@ -1,8 +1,10 @@
-"""Simulator control: fault injection commands, on ``sim/fault``."""
+"""Simulator control: fault injection (queries on ``sim/fault``) and the
+simulator's ground truth (queries on ``sim/state``)."""
 
 from __future__ import annotations
 
-from proto.base import Fraction, Id, Message, Positive
+from proto.base import Fraction, Id, Message, Positive, Record
+from proto.geo import Point
 
 
 class BatteryFault(Message, frozen=True, kw_only=True, tag="battery"):
@@ -33,3 +35,45 @@ class GpsFreeze(Message, frozen=True, kw_only=True, tag="gps"):
 
 
 SimFault = BatteryFault | MotorFailure | LinkDrop | GpsFreeze
+
+
+class FaultApplied(Message, frozen=True, kw_only=True):
+    """The simulator's reply to a fault: what it did, at which simulated time."""
+
+    uav_id: Id
+    detail: str
+    sim_time_s: float
+
+
+class GetSimState(Message, frozen=True, kw_only=True, tag="sim_state"):
+    """Ask the simulator for its ground truth, on ``sim/state``."""
+
+
+class DeliveryRecord(Record, frozen=True, kw_only=True):
+    """A tool released within reach of a worker (the simulator's truth)."""
+
+    tool: str
+    uav_id: Id
+    worker_id: Id
+    sim_time_s: float
+
+
+class VehicleTruth(Record, frozen=True, kw_only=True):
+    """A vehicle as the simulator knows it."""
+
+    uav_id: Id
+    position: Point
+    battery_fraction: Fraction
+    state: str
+    armed: bool
+    tool: str | None = None
+    docked_at: Id | None = None
+
+
+class SimState(Message, frozen=True, kw_only=True):
+    """The simulator's ground truth: time, vehicles, deliveries."""
+
+    sim_time_s: float
+    speedup: float
+    vehicles: list[VehicleTruth] = []
+    deliveries: list[DeliveryRecord] = []

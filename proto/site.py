@@ -63,11 +63,21 @@ class ToolStation(Record, frozen=True, kw_only=True):
     tools: list[Tool] = []
 
 
+class TimedPoint(Record, frozen=True, kw_only=True):
+    """Where a scripted worker is ``at_s`` seconds after the simulation starts."""
+
+    at_s: NonNegative
+    position: Point
+
+
 class Worker(Record, frozen=True, kw_only=True):
-    """A human worker; ``position`` is where they start (the tracker moves them)."""
+    """A human worker; ``position`` is where they start. A simulated worker
+    follows ``path`` (straight lines between its points, e.g. climbing a
+    tower); a real one is wherever the human tracker says."""
 
     id: Id
     position: Point
+    path: list[TimedPoint] = []
 
 
 class Site(Message, frozen=True, kw_only=True):

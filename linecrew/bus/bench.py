@@ -10,19 +10,17 @@ from __future__ import annotations
 
 import argparse
 import asyncio
-import contextlib
 import json
 import os
 import signal
-import socket
 import statistics
 import subprocess
 import sys
 import threading
 import time
-from collections.abc import Iterator
 
 from linecrew.bus.config import BusConfig
+from linecrew.bus.router_process import router_process
 from linecrew.bus.session import Bus
 from proto import GeoPoint, GetHistory, HistoryReply, KeySpace, Point, Role, Telemetry
 
@@ -47,33 +45,6 @@ def _percentiles(values: list[float]) -> dict[str, float]:
     ordered = sorted(values)
     p99 = ordered[min(len(ordered) - 1, int(0.99 * len(ordered)))]
     return {"p50_ms": statistics.median(ordered) * 1e3, "p99_ms": p99 * 1e3}
-
-
-@contextlib.contextmanager
-def _router(lease_ms: int) -> Iterator[str]:
-    with socket.socket() as sock:
-        sock.bind(("127.0.0.1", 0))
-        port = sock.getsockname()[1]
-    endpoint = f"tcp/127.0.0.1:{port}"
-    args = [
-        sys.executable,
-        "-m",
-        "ground_station.router",
-        "--listen",
-        endpoint,
-        "--site",
-        "bench",
-        "--lease-ms",
-        str(lease_ms),
-        "--log-level",
-        "warning",
-    ]
-    proc = subprocess.Popen(args, start_new_session=True)
-    try:
-        yield endpoint
-    finally:
-        proc.terminate()
-        proc.wait(10)
 
 
 def _latency(pub: Bus, sub: Bus, count: int, period_s: float) -> dict[str, float]:
@@ -173,7 +144,7 @@ def _vanish_time(watcher: Bus, endpoint: str, lease_ms: int, sig: signal.Signals
 
 def run(samples: int, lease_ms: int, repeats: int) -> dict[str, dict[str, float]]:
     """Run every measurement; returns name -> metrics."""
-    with _router(lease_ms) as endpoint:
+    with router_process("bench", lease_ms) as endpoint:
         config = BusConfig(connect=(endpoint,), lease_ms=lease_ms)
         with Bus.open(config) as a, Bus.open(config) as b:
             results = {

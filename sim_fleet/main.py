@@ -1,0 +1,91 @@
+"""``linecrew sim``: the fleet simulator process.
+
+N simulated multirotors, each a MAVLink endpoint on ``base_port + i`` (like
+ArduCopter SITL), the simulated human tracker, fault injection (queries on
+``sim/fault``) and the ground truth (queries on ``sim/state``), all on one
+asyncio loop. Health: the ``alive/sim/{id}`` token.
+"""
+
+from __future__ import annotations
+
+import asyncio
+import logging
+import sys
+
+from linecrew.bus import Bus
+from linecrew.process import Shutdown, common_parser, start
+from linecrew.scenarios import ScenarioError, load
+from proto.errors import Unavailable
+from proto.keys import KeySpace, Role
+from proto.scenario import Scenario
+from proto.sim import GetSimState, SimFault
+from sim_fleet.faults import apply_fault
+from sim_fleet.fleet import Fleet, FleetConfig
+from sim_fleet.from_proto import scenario_from_proto
+from sim_fleet.tracker import HumanTracker
+from sim_fleet.truth import sim_state
+
+log = logging.getLogger("linecrew.sim")
+
+
+async def serve(
+    scenario: Scenario, fleet: Fleet, bus: Bus, shutdown: Shutdown, sim_id: str, pose_hz: float
+) -> int:
+    """Run the simulator until ``shutdown``; 1 if its ports cannot be bound."""
+    try:
+        await fleet.start()
+    except OSError as exc:
+        log.error("simulator cannot bind its MAVLink ports: %s", exc)
+        return 1
+    keys = KeySpace(scenario.site.id)
+    world, speedup = fleet.world, fleet.config.speedup
+    bus.serve(keys.sim("fault"), SimFault, lambda fault: apply_fault(world, fault))
+    bus.serve(keys.sim("state"), GetSimState, lambda _request: sim_state(world, speedup))
+    bus.declare_token(keys.alive(Role.SIM, sim_id))
+    log.info(
+        "simulating %d UAVs at x%g", len(fleet.endpoints), speedup, extra={"ports": fleet.ports}
+    )
+    tracker = HumanTracker(scenario.site, world, bus)
+    async with asyncio.TaskGroup() as group:
+        running = group.create_task(fleet.run())
+        poses = group.create_task(tracker.run(pose_hz))
+        await shutdown.wait_async()
+        poses.cancel()
+        fleet.stop()
+        await running
+    return 0
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Run until SIGINT/SIGTERM; exit 1 on a fatal start-up error."""
+    parser = common_parser("linecrew sim", "MAVLink fleet simulator with a human tracker")
+    parser.add_argument("--scenario", default="paper", help="shipped scenario name or file")
+    parser.add_argument("--speedup", type=float, default=1.0, help="simulated s per wall s")
+    parser.add_argument(
+        "--base-port",
+        type=int,
+        default=14560,
+        help="UDP port of the first vehicle (vehicle i: base + i)",
+    )
+    parser.add_argument("--host", default="127.0.0.1", help="address the endpoints bind to")
+    parser.add_argument("--pose-hz", type=float, default=4.0, help="worker pose rate")
+    parser.add_argument("--id", default="sim", help="liveliness token name")
+    args = parser.parse_args(argv)
+    bus_config = start(args, "sim")
+    shutdown = Shutdown().install()
+    try:
+        scenario = load(args.scenario)
+        bus = Bus.open(bus_config, should_stop=shutdown.is_set)
+    except (ScenarioError, Unavailable) as exc:
+        log.error("simulator cannot start: %s", exc)
+        return 1
+    config = FleetConfig(speedup=args.speedup, base_port=args.base_port, host=args.host)
+    fleet = Fleet(scenario_from_proto(scenario.site, scenario.fleet), config)
+    with bus:
+        code = asyncio.run(serve(scenario, fleet, bus, shutdown, args.id, args.pose_hz))
+    log.info("simulator stopped on %s", shutdown.signal_name or "request")
+    return code
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,346 @@
+"""One vehicle's MAVLink 2 endpoint on its own UDP port, speaking like ArduCopter.
+
+Transport (the SITL shape): the endpoint *listens* on its UDP port, like
+ArduPilot SITL's ``udpin``-able serial port or PX4's fixed local port. Every
+address that sends it a valid MAVLink packet becomes a peer that receives
+telemetry (a pymavlink ``udpout:127.0.0.1:PORT`` or MAVSDK ``udpout://``
+client connects by sending anything, e.g. its GCS heartbeat). Configured
+static peers (like SITL ``udpclient:HOST:PORT`` or PX4's remote port) get
+telemetry from the start, so ``udpin`` clients work too. COMMAND_ACKs go only
+to the address that sent the command.
+
+This is the only pymavlink importer in ``sim_fleet``. Untrusted bytes never
+raise out of here: each datagram gets a fresh parser (MAVLink over UDP puts
+whole packets in a datagram, so garbage cannot eat the next one), and bad
+datagrams are counted and logged once per source.
+"""
+
+from __future__ import annotations
+
+import asyncio
+import logging
+import math
+import os
+import time
+from typing import Any, cast
+
+os.environ["MAVLINK20"] = "1"  # for any mavutil user in this process; we use the v20 dialect
+from pymavlink.dialects.v20 import ardupilotmega as mav
+
+from sim_fleet import autopilot, frames, streams
+from sim_fleet.events import Outcome, Result, Severity
+from sim_fleet.modes import LANDED_STATE, base_mode, system_status
+from sim_fleet.vehicle import Vehicle
+from sim_fleet.world import World
+
+log = logging.getLogger(__name__)
+
+AUTOPILOT_COMPONENT = 1
+MAX_LEARNED_PEERS = 8
+POS_IGNORE = 0b111
+VEL_IGNORE = 0b111000
+# AUTOPILOT_VERSION: ArduCopter 4.5.0 official
+FLIGHT_SW_VERSION = (4 << 24) | (5 << 16) | (0 << 8) | 255
+CAPABILITIES = (
+    mav.MAV_PROTOCOL_CAPABILITY_COMMAND_INT
+    | mav.MAV_PROTOCOL_CAPABILITY_SET_POSITION_TARGET_LOCAL_NED
+    | mav.MAV_PROTOCOL_CAPABILITY_SET_POSITION_TARGET_GLOBAL_INT
+    | mav.MAV_PROTOCOL_CAPABILITY_MAVLINK2
+)
+SENSORS = 0x1 | 0x2 | 0x4 | 0x8 | 0x20 | 0x8000 | 0x2000000  # gyro..gps, motors, battery
+SENSOR_BATTERY = 0x2000000
+UINT16_MAX = 65535
+
+Addr = tuple[str, int]
+
+
+class VehicleEndpoint(asyncio.DatagramProtocol):
+    def __init__(
+        self,
+        world: World,
+        vehicle: Vehicle,
+        *,
+        rates: streams.TelemetryRates | None = None,
+        static_peers: tuple[Addr, ...] = (),
+    ) -> None:
+        self.world = world
+        self.vehicle = vehicle
+        self.schedule = streams.StreamSchedule(rates or streams.TelemetryRates())
+        self.static_peers = tuple(static_peers)
+        self.peers: dict[Addr, float] = {}  # learned peer -> last heard (monotonic)
+        self.bad_datagrams = 0
+        self._logged_bad: set[str] = set()
+        self._mav = mav.MAVLink(None, srcSystem=vehicle.sysid, srcComponent=AUTOPILOT_COMPONENT)
+        self._transport: asyncio.DatagramTransport | None = None
+
+    # ---- asyncio protocol ------------------------------------------------
+    def connection_made(self, transport: asyncio.BaseTransport) -> None:
+        self._transport = cast(asyncio.DatagramTransport, transport)
+
+    @property
+    def port(self) -> int:
+        assert self._transport is not None
+        return int(self._transport.get_extra_info("sockname")[1])
+
+    def error_received(self, exc: Exception) -> None:
+        log.debug("%s: socket error %s", self.vehicle.id, exc, extra={"uav_id": self.vehicle.id})
+
+    def datagram_received(self, data: bytes, addr: Addr) -> None:
+        if not self.vehicle.link_up():
+            return
+        try:
+            parser = mav.MAVLink(None)
+            parser.robust_parsing = True
+            msgs = parser.parse_buffer(data) or []
+        except Exception as exc:  # untrusted bytes: any decoder failure is a bad datagram
+            self._bad(addr, repr(exc))
+            return
+        for msg in msgs:
+            if msg.get_type() == "BAD_DATA":
+                self._bad(addr, "bad data")
+                continue
+            self._learn(addr)
+            try:
+                self._handle(msg, addr)
+            except Exception:  # a bug in one handler must not take the endpoint down
+                log.exception("%s: failed handling %s", self.vehicle.id, msg.get_type())
+
+    def _bad(self, addr: Addr, why: str) -> None:
+        self.bad_datagrams += 1
+        if addr[0] not in self._logged_bad:
+            self._logged_bad.add(addr[0])
+            log.warning("%s: dropping bad datagram from %s: %s", self.vehicle.id, addr, why)
+
+    def _learn(self, addr: Addr) -> None:
+        self.peers[addr] = time.monotonic()
+        if len(self.peers) > MAX_LEARNED_PEERS:
+            oldest = min(self.peers, key=self.peers.__getitem__)
+            del self.peers[oldest]
+
+    # ---- incoming --------------------------------------------------------
+    def _for_me(self, msg: Any) -> bool:
+        return msg.target_system in (0, self.vehicle.sysid) and msg.target_component in (
+            0,
+            AUTOPILOT_COMPONENT,
+        )
+
+    def _handle(self, msg: Any, addr: Addr) -> None:
+        match msg.get_type():
+            case "COMMAND_LONG" if self._for_me(msg):
+                p = (
+                    msg.param1,
+                    msg.param2,
+                    msg.param3,
+                    msg.param4,
+                    msg.param5,
+                    msg.param6,
+                    msg.param7,
+                )
+                self._command(autopilot.Command(msg.command, p), msg, addr)
+            case "COMMAND_INT" if self._for_me(msg):
+                p = (
+                    msg.param1,
+                    msg.param2,
+                    msg.param3,
+                    msg.param4,
+                    float(msg.x),
+                    float(msg.y),
+                    msg.z,
+                )
+                self._command(autopilot.Command(msg.command, p, msg.frame), msg, addr)
+            case "SET_MODE" if msg.target_system == self.vehicle.sysid:
+                outcome = autopilot.set_mode(self.vehicle, msg.base_mode, msg.custom_mode)
+                self._ack(mav.MAVLINK_MSG_ID_SET_MODE, outcome, msg, addr)
+            case "SET_POSITION_TARGET_GLOBAL_INT" if self._for_me(msg):
+                self._global_target(msg)
+            case "SET_POSITION_TARGET_LOCAL_NED" if self._for_me(msg):
+                self._local_target(msg)
+            case _:
+                pass  # HEARTBEAT and everything else: only makes the sender a peer
+
+    def _command(self, cmd: autopilot.Command, msg: Any, addr: Addr) -> None:
+        p = cmd.params
+        match cmd.command:
+            case mav.MAV_CMD_SET_MESSAGE_INTERVAL:
+                ok = self.schedule.set_interval(autopilot.as_int(p[0]), p[1])
+                text = None if ok else f"No ap_message for mavlink id ({autopilot.as_int(p[0])})"
+                outcome = Outcome(Result.ACCEPTED if ok else Result.DENIED, text)
+            case mav.MAV_CMD_GET_MESSAGE_INTERVAL:
+                outcome = Outcome(Result.ACCEPTED)
+            case mav.MAV_CMD_REQUEST_MESSAGE:
+                ok = autopilot.as_int(p[0]) in streams.REQUESTABLE
+                outcome = Outcome(Result.ACCEPTED if ok else Result.FAILED)
+            case mav.MAV_CMD_REQUEST_AUTOPILOT_CAPABILITIES:
+                outcome = Outcome(Result.ACCEPTED)
+            case _:
+                outcome = autopilot.handle_command(cmd, self.vehicle, self.world)
+        self._ack(cmd.command, outcome, msg, addr)
+        if outcome.result is not Result.ACCEPTED:
+            return
+        match cmd.command:  # replies that follow the ACK, as ArduPilot sends them
+            case mav.MAV_CMD_GET_MESSAGE_INTERVAL:
+                iv = self.schedule.interval_us(autopilot.as_int(p[0]))
+                self._send_to([addr], self._mav.message_interval_encode(autopilot.as_int(p[0]), iv))
+            case mav.MAV_CMD_REQUEST_MESSAGE:
+                self._send_to([addr], self._encode(autopilot.as_int(p[0])))
+            case mav.MAV_CMD_REQUEST_AUTOPILOT_CAPABILITIES:
+                self._send_to([addr], self._encode(streams.AUTOPILOT_VERSION))
+
+    def _ack(self, command: int, outcome: Outcome, msg: Any, addr: Addr) -> None:
+        if outcome.text:
+            severity = Severity.WARNING if outcome.result else Severity.INFO
+            self._send_to([addr], self._statustext(severity, outcome.text))
+        ack = self._mav.command_ack_encode(
+            command, int(outcome.result), 0, 0, msg.get_srcSystem(), msg.get_srcComponent()
+        )
+        self._send_to([addr], ack)
+
+    def _global_target(self, msg: Any) -> None:
+        v = self.vehicle
+        pos = vel = None
+        if not msg.type_mask & POS_IGNORE:
+            pos = frames.global_to_enu(
+                self.world.geo, msg.coordinate_frame, msg.lat_int / 1e7, msg.lon_int / 1e7, msg.alt
+            )
+            if pos is None:
+                autopilot.hold(v)
+                return
+        elif not msg.type_mask & VEL_IGNORE:
+            vel = frames.ned_to_enu((msg.vx, msg.vy, msg.vz))
+            if not all(math.isfinite(c) and abs(c) < 1000 for c in vel):
+                autopilot.hold(v)
+                return
+        autopilot.position_target(v, pos, vel)
+
+    def _local_target(self, msg: Any) -> None:
+        v = self.vehicle
+        frame = msg.coordinate_frame
+        pos = vel = None
+        if not msg.type_mask & POS_IGNORE:
+            pos = frames.local_to_enu(
+                frame, (msg.x, msg.y, msg.z), v.home, v.position, v.heading_deg
+            )
+            if pos is None:
+                autopilot.hold(v)
+                return
+        elif not msg.type_mask & VEL_IGNORE:
+            vel = frames.local_velocity_to_enu(frame, (msg.vx, msg.vy, msg.vz), v.heading_deg)
+            if vel is None:
+                autopilot.hold(v)
+                return
+        autopilot.position_target(v, pos, vel)
+
+    # ---- outgoing --------------------------------------------------------
+    def tick(self) -> None:
+        """Send due telemetry and pending STATUSTEXTs; called after each world step."""
+        texts = self.vehicle.take_texts()
+        if not self.vehicle.link_up() or self._transport is None:
+            return
+        peers = [*self.static_peers, *self.peers]
+        if not peers:
+            return
+        for t in texts:
+            self._send_to(peers, self._statustext(int(t.severity), t.text))
+        for msg_id in self.schedule.due(self.world.time_s):
+            self._send_to(peers, self._encode(msg_id))
+
+    def _send_to(self, addrs: list[Addr], msg: Any) -> None:
+        if self._transport is None or self._transport.is_closing() or msg is None:
+            return
+        if not self.vehicle.link_up():
+            return
+        buf = msg.pack(self._mav)
+        for addr in addrs:
+            try:
+                self._transport.sendto(buf, addr)
+            except OSError as exc:
+                log.debug("%s: send to %s failed: %s", self.vehicle.id, addr, exc)
+
+    def _statustext(self, severity: int, text: str) -> Any:
+        return self._mav.statustext_encode(severity, text.encode("ascii", "replace")[:50])
+
+    def _encode(self, msg_id: int) -> Any:
+        """Build one telemetry message from the vehicle's state (None if unknown)."""
+        v, m = self.vehicle, self._mav
+        boot_ms = int(self.world.time_s * 1000) & 0xFFFFFFFF
+        pos, vel = v.reported_position()
+        battery = v.battery
+        pct = max(0, min(100, round(battery.soc * 100)))
+        match msg_id:
+            case streams.HEARTBEAT:
+                critical = battery.soc <= v.params.critical_soc
+                return m.heartbeat_encode(
+                    mav.MAV_TYPE_QUADROTOR,
+                    mav.MAV_AUTOPILOT_ARDUPILOTMEGA,
+                    base_mode(v.mode, v.armed),
+                    int(v.mode),
+                    system_status(v.armed, v.state, critical),
+                )
+            case streams.GLOBAL_POSITION_INT:
+                lat, lon, alt = self.world.geo.to_geodetic(pos)
+                return m.global_position_int_encode(
+                    boot_ms, round(lat * 1e7), round(lon * 1e7), round(alt * 1000),
+                    round(pos[2] * 1000), round(vel[1] * 100), round(vel[0] * 100),
+                    round(-vel[2] * 100), round(v.heading_deg * 100) % 36000,
+                )  # fmt: skip
+            case streams.ATTITUDE:
+                yaw = math.radians(v.heading_deg)
+                yaw = yaw - 2 * math.pi if yaw > math.pi else yaw
+                return m.attitude_encode(boot_ms, 0.0, 0.0, yaw, 0.0, 0.0, 0.0)
+            case streams.VFR_HUD:
+                _, _, alt = self.world.geo.to_geodetic(pos)
+                gs = math.hypot(vel[0], vel[1])
+                throttle = 50 if v.armed and v.airborne else 0
+                return m.vfr_hud_encode(gs, gs, round(v.heading_deg) % 360, throttle, alt, vel[2])
+            case streams.SYS_STATUS:
+                health = (
+                    SENSORS if battery.soc > v.params.critical_soc else SENSORS & ~SENSOR_BATTERY
+                )
+                return m.sys_status_encode(
+                    SENSORS, SENSORS, health, 0, round(battery.voltage_v() * 1000),
+                    round(battery.current_a() * 100), pct, 0, 0, 0, 0, 0, 0,
+                )  # fmt: skip
+            case streams.BATTERY_STATUS:
+                return self._battery_status(pct)
+            case streams.EXTENDED_SYS_STATE:
+                return m.extended_sys_state_encode(0, LANDED_STATE[v.state])
+            case streams.HOME_POSITION:
+                lat, lon, alt = self.world.geo.to_geodetic(v.home)
+                return m.home_position_encode(
+                    round(lat * 1e7), round(lon * 1e7), round(alt * 1000), 0.0, 0.0, 0.0,
+                    [1.0, 0.0, 0.0, 0.0], 0.0, 0.0, 0.0, boot_ms * 1000,
+                )  # fmt: skip
+            case streams.AUTOPILOT_VERSION:
+                zeros = [0] * 8
+                return m.autopilot_version_encode(
+                    CAPABILITIES, FLIGHT_SW_VERSION, 0, 0, 0, zeros, zeros, zeros, 0, 0, v.sysid
+                )
+        return None
+
+    def _battery_status(self, pct: int) -> Any:
+        v = self.vehicle
+        b = v.battery
+        docked = self.world.station_status(v.id)
+        if docked is not None and docked[1] == "charging":
+            charge_state = mav.MAV_BATTERY_CHARGE_STATE_CHARGING
+        elif b.soc <= v.params.critical_soc:
+            charge_state = mav.MAV_BATTERY_CHARGE_STATE_CRITICAL
+        elif b.soc <= v.params.low_soc:
+            charge_state = mav.MAV_BATTERY_CHARGE_STATE_LOW
+        else:
+            charge_state = mav.MAV_BATTERY_CHARGE_STATE_OK
+        remaining_s = round(b.energy_wh * 3600 / b.load_w) if b.load_w > 0 else 0
+        voltages = [min(round(b.voltage_v() * 1000), UINT16_MAX - 1)] + [UINT16_MAX] * 9
+        return self._mav.battery_status_encode(
+            0,
+            mav.MAV_BATTERY_FUNCTION_ALL,
+            mav.MAV_BATTERY_TYPE_LIPO,
+            32767,  # temperature unknown (INT16_MAX)
+            voltages,
+            round(b.current_a() * 100),  # cA
+            round(b.consumed_mah()),  # mAh
+            round(b.consumed_wh * 36),  # hJ
+            pct,
+            remaining_s,
+            charge_state,
+        )

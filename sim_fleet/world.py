@@ -1,0 +1,146 @@
+"""The simulated world: vehicles, charging stations, tool stations and workers.
+
+``World.step(dt_s)`` advances everything by ``dt_s`` simulated seconds in fixed
+physics steps of ``physics_step_s`` (a remainder is carried to the next call),
+so the trajectory is the same whatever the speed-up or the caller's tick.
+Nothing here reads a clock or sleeps; the runner (``fleet``) or a test decides
+how much time passes. Fault operations are plain methods on the
+world and its vehicles so the later Zenoh fault service only has to call them.
+"""
+
+from __future__ import annotations
+
+import logging
+import math
+
+from sim_fleet import physics
+from sim_fleet.events import Severity
+from sim_fleet.geo import GeoFrame
+from sim_fleet.modes import FlightState
+from sim_fleet.scenario import Scenario, Vec3
+from sim_fleet.stations import ChargingStation
+from sim_fleet.tools import Delivery, Drop, ToolStation, station_in_reach, worker_in_reach
+from sim_fleet.vehicle import AutopilotParams, Vehicle
+
+log = logging.getLogger(__name__)
+
+
+class World:
+    def __init__(
+        self,
+        scenario: Scenario,
+        *,
+        params: AutopilotParams | None = None,
+        physics_step_s: float = 0.05,
+        first_sysid: int = 1,
+    ) -> None:
+        self.scenario = scenario
+        self.rules = scenario.rules
+        self.geo = GeoFrame(scenario.origin)
+        self.physics_step_s = physics_step_s
+        self.time_s = 0.0
+        self._pending_s = 0.0
+        self.vehicles: dict[str, Vehicle] = {}
+        for i, spec in enumerate(scenario.vehicles):
+            home = scenario.station(spec.home_station).position
+            self.vehicles[spec.id] = Vehicle(
+                spec, scenario.types[spec.type], sysid=first_sysid + i, home=home, params=params
+            )
+        self.charging = {
+            s.id: ChargingStation(s) for s in scenario.stations if s.recharge is not None
+        }
+        self.tool_stations = {t.id: ToolStation(t) for t in scenario.tool_stations}
+        self.workers: dict[str, Vec3] = {w.id: w.position for w in scenario.workers}
+        self.deliveries: list[Delivery] = []
+        self.drops: list[Drop] = []
+
+    def vehicle(self, vehicle_id: str) -> Vehicle:
+        return self.vehicles[vehicle_id]
+
+    # ---- time -------------------------------------------------------------
+    def step(self, dt_s: float) -> None:
+        """Advance the world by ``dt_s`` simulated seconds."""
+        if dt_s <= 0.0:
+            return
+        h = self.physics_step_s
+        self._pending_s += dt_s
+        n = math.floor(self._pending_s / h + 1e-9)
+        self._pending_s = max(0.0, self._pending_s - n * h)
+        for _ in range(n):
+            self.time_s += h
+            for v in self.vehicles.values():
+                v.step(h, self.time_s)
+            self._recharge(h)
+
+    def _recharge(self, dt_s: float) -> None:
+        dock_r = self.rules.dock_radius_m
+        for station in self.charging.values():
+            docked = [
+                v.id
+                for v in self.vehicles.values()
+                if v.state is FlightState.LANDED
+                and not v.armed
+                and physics.horizontal_distance(v.position, station.spec.position) <= dock_r
+            ]
+            if not docked and not station.on_pads and not station.queue:
+                continue
+            notices = station.update_docked(docked)
+            batteries = {vid: self.vehicles[vid].battery for vid in docked}
+            notices += station.step(dt_s, batteries)
+            for vid, text in notices:
+                self.vehicles[vid].say(Severity.INFO, text)
+
+    def station_status(self, vehicle_id: str) -> tuple[str, str] | None:
+        """(station id, "charging" | "charged" | "queued") for a docked vehicle."""
+        for station in self.charging.values():
+            status = station.status_of(vehicle_id)
+            if status is not None:
+                return station.id, status
+        return None
+
+    # ---- gripper (ToolHooks) ----------------------------------------------
+    def grab(self, vehicle: Vehicle) -> str:
+        if vehicle.holding is not None:
+            return f"Gripper: already holding {vehicle.holding.id}"
+        landed = vehicle.state is FlightState.LANDED
+        hovering = (
+            vehicle.state is FlightState.FLYING
+            and physics.speed(vehicle.velocity) <= self.rules.hover_speed_mps
+        )
+        station = None
+        if landed or hovering:
+            stations = list(self.tool_stations.values())
+            station = station_in_reach(vehicle.position, stations, self.rules, with_tools=True)
+        tool = station.take() if station is not None else None
+        if station is None or tool is None:
+            return "Gripper: grabbed nothing"
+        vehicle.holding = tool
+        log.info("%s grabbed %s at %s", vehicle.id, tool.id, station.id)
+        return f"Gripper: grabbed {tool.id} at {station.id}"
+
+    def release(self, vehicle: Vehicle) -> str:
+        tool, vehicle.holding = vehicle.holding, None
+        if tool is None:
+            return "Gripper: released nothing"
+        pos = vehicle.position
+        worker = worker_in_reach(pos, self.workers, self.rules)
+        if worker is not None:
+            self.deliveries.append(Delivery(tool.id, vehicle.id, worker, self.time_s, pos))
+            log.info("%s delivered %s to %s", vehicle.id, tool.id, worker)
+            return f"Gripper: delivered {tool.id} to {worker}"
+        stations = list(self.tool_stations.values())
+        station = station_in_reach(pos, stations, self.rules, with_tools=False)
+        if station is not None:
+            station.put(tool)
+        sid = station.id if station is not None else None
+        self.drops.append(Drop(tool.id, vehicle.id, self.time_s, pos, sid))
+        return f"Gripper: returned {tool.id} to {sid}" if sid else f"Gripper: dropped {tool.id}"
+
+    # ---- faults -----------------------------------------------------------
+    def move_worker(self, worker_id: str, position: Vec3) -> None:
+        if worker_id not in self.workers:
+            raise KeyError(worker_id)
+        self.workers[worker_id] = position
+
+    def fail_gripper(self, vehicle_id: str, failed: bool = True) -> None:
+        self.vehicles[vehicle_id].gripper_failed = failed

@@ -1,0 +1,67 @@
+"""Wire fault commands on the world, scripted workers, and the ground truth."""
+
+from __future__ import annotations
+
+import pytest
+
+from linecrew.scenarios import load
+from proto import BatteryFault, GpsFreeze, LinkDrop, MotorFailure, Point
+from proto.site import TimedPoint, Worker
+from sim_fleet.faults import UnknownVehicle, apply_fault
+from sim_fleet.from_proto import scenario_from_proto
+from sim_fleet.truth import sim_state
+from sim_fleet.workers import worker_position
+from sim_fleet.world import World
+
+PAPER = load("paper")
+
+
+@pytest.fixture
+def world():
+    return World(scenario_from_proto(PAPER.site, PAPER.fleet))
+
+
+def test_battery_fault_sets_the_charge(world):
+    reply = apply_fault(world, BatteryFault(uav_id="uav-1", fraction=0.25))
+    assert world.vehicle("uav-1").battery.soc == pytest.approx(0.25)
+    assert reply.uav_id == "uav-1" and "25%" in reply.detail
+
+
+def test_motor_link_and_gps_faults_reach_the_vehicle(world):
+    apply_fault(world, MotorFailure(uav_id="uav-2"))
+    apply_fault(world, LinkDrop(uav_id="uav-3", duration_s=7))
+    apply_fault(world, GpsFreeze(uav_id="uav-1", duration_s=3))
+    assert world.vehicle("uav-2").motors_failed
+    assert world.vehicle("uav-3").link_down_until == pytest.approx(7)
+    assert world.vehicle("uav-1").gps_frozen_until == pytest.approx(3)
+
+
+def test_unknown_uav_is_a_clear_error(world):
+    with pytest.raises(UnknownVehicle, match="known: uav-1, uav-2, uav-3") as caught:
+        apply_fault(world, MotorFailure(uav_id="ghost"))
+    assert caught.value.field == "uav_id"
+
+
+def test_ground_truth_lists_every_vehicle_on_its_pad(world):
+    world.step(1.0)
+    state = sim_state(world, speedup=3.0)
+    assert [v.uav_id for v in state.vehicles] == ["uav-1", "uav-2", "uav-3"]
+    assert all(v.state == "landed" and not v.armed for v in state.vehicles)
+    assert state.sim_time_s == pytest.approx(1.0)
+
+
+def test_scripted_worker_moves_in_straight_lines_and_stops_at_the_end():
+    start = Point(x_m=0, y_m=0, z_m=0)
+    worker = Worker(
+        id="W",
+        position=start,
+        path=[
+            TimedPoint(at_s=10, position=Point(x_m=10, y_m=0, z_m=0)),
+            TimedPoint(at_s=20, position=Point(x_m=10, y_m=0, z_m=20)),
+        ],
+    )
+    assert worker_position(worker, 0) == start
+    assert worker_position(worker, 5) == Point(x_m=5, y_m=0, z_m=0)
+    assert worker_position(worker, 15) == Point(x_m=10, y_m=0, z_m=10)
+    assert worker_position(worker, 99) == Point(x_m=10, y_m=0, z_m=20)
+    assert worker_position(Worker(id="S", position=start), 50) == start
