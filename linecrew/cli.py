@@ -18,6 +18,7 @@ COMMANDS: dict[str, tuple[str, str]] = {
 BENCHES: dict[str, tuple[str, str]] = {
     "bus": ("linecrew.bus.bench:main", "Zenoh bus latency, throughput, liveliness"),
     "ground-station": ("ground_station.bench:main", "event-to-plan latency, loss detection"),
+    "sim": ("sim_fleet.bench:main", "simulator physics rate, telemetry rate, CPU"),
 }
 
 

@@ -34,13 +34,50 @@ class GpsFreeze(Message, frozen=True, kw_only=True, tag="gps"):
     duration_s: Positive
 
 
-SimFault = BatteryFault | MotorFailure | LinkDrop | GpsFreeze
+class DrainFault(Message, frozen=True, kw_only=True, tag="drain"):
+    """``uav_id`` draws ``multiplier`` times its modelled power from now on."""
+
+    uav_id: Id
+    multiplier: Positive
+
+
+class KillVehicle(Message, frozen=True, kw_only=True, tag="kill"):
+    """``uav_id`` is lost: no more heartbeats, and it falls."""
+
+    uav_id: Id
+
+
+class GripperFailure(Message, frozen=True, kw_only=True, tag="gripper"):
+    """``uav_id``'s gripper stops working (``failed=False`` repairs it)."""
+
+    uav_id: Id
+    failed: bool = True
+
+
+class MoveWorker(Message, frozen=True, kw_only=True, tag="move_worker"):
+    """Put worker ``worker_id`` at ``position`` (a worker without a scripted path)."""
+
+    worker_id: Id
+    position: Point
+
+
+SimFault = (
+    BatteryFault
+    | MotorFailure
+    | LinkDrop
+    | GpsFreeze
+    | DrainFault
+    | KillVehicle
+    | GripperFailure
+    | MoveWorker
+)
 
 
 class FaultApplied(Message, frozen=True, kw_only=True):
-    """The simulator's reply to a fault: what it did, at which simulated time."""
+    """The simulator's reply to a fault: on what (a UAV or worker id), what it
+    did, at which simulated time."""
 
-    uav_id: Id
+    target: Id
     detail: str
     sim_time_s: float
 

@@ -57,7 +57,13 @@ async def serve(
 
 
 def main(argv: list[str] | None = None) -> int:
-    """Run until SIGINT/SIGTERM; exit 1 on a fatal start-up error."""
+    """Run until SIGINT/SIGTERM; exit 1 on a fatal start-up error.
+    ``linecrew sim fault ...`` injects a fault into a running simulator."""
+    argv = sys.argv[1:] if argv is None else argv
+    if argv[:1] == ["fault"]:
+        from sim_fleet.fault_cli import main as fault_main
+
+        return fault_main(argv[1:])
     parser = common_parser("linecrew sim", "MAVLink fleet simulator with a human tracker")
     parser.add_argument("--scenario", default="paper", help="shipped scenario name or file")
     parser.add_argument("--speedup", type=float, default=1.0, help="simulated s per wall s")

@@ -7,7 +7,7 @@ import asyncio
 import time
 
 from linecrew.bus import Bus
-from proto.geo import LocalFrame
+from proto.geo import LocalFrame, Point
 from proto.keys import KeySpace
 from proto.site import Site
 from proto.telemetry import HumanPose
@@ -26,10 +26,15 @@ class HumanTracker:
         self.frame = LocalFrame(site.origin)
 
     def publish_once(self) -> None:
-        """Move scripted workers to where they are now, and publish all poses."""
+        """Move scripted workers along their paths, and publish every pose
+        (a worker without a path stays where the world has it)."""
         for worker in self.site.workers:
-            position = worker_position(worker, self.world.time_s)
-            self.world.move_worker(worker.id, (position.x_m, position.y_m, position.z_m))
+            if worker.path:
+                position = worker_position(worker, self.world.time_s)
+                self.world.move_worker(worker.id, (position.x_m, position.y_m, position.z_m))
+            else:
+                x, y, z = self.world.workers[worker.id]
+                position = Point(x_m=x, y_m=y, z_m=z)
             pose = HumanPose(
                 worker_id=worker.id,
                 stamp_s=time.time(),

@@ -12,6 +12,7 @@ import pathlib
 import msgspec
 
 from proto.errors import LinecrewError
+from proto.fleet import UavSpec
 from proto.scenario import Scenario
 
 _HERE = pathlib.Path(__file__).parent
@@ -38,6 +39,23 @@ def load(name_or_path: str) -> Scenario:
             f"no scenario {name_or_path!r}: not a file, nor one of {', '.join(builtin_names())}"
         )
     return parse(path.read_bytes(), json=path.suffix == ".json", source=str(path))
+
+
+def with_fleet_size(scenario: Scenario, uavs: int) -> Scenario:
+    """``scenario`` with ``uavs`` UAVs cycling through its types and stations
+    (ids ``uav-00``...), for benchmarks and scale tests."""
+    types = [t.name for t in scenario.fleet.types]
+    stations = [s.id for s in scenario.site.stations]
+    specs = [
+        UavSpec(
+            id=f"uav-{i:02d}", type=types[i % len(types)], home_station=stations[i % len(stations)]
+        )
+        for i in range(uavs)
+    ]
+    fleet = msgspec.structs.replace(scenario.fleet, uavs=specs)
+    return msgspec.structs.replace(
+        scenario, name=f"{scenario.name}-x{uavs}", fleet=fleet, actions=[]
+    )
 
 
 def parse(data: bytes, *, json: bool = False, source: str = "<scenario>") -> Scenario:

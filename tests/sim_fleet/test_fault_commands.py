@@ -5,9 +5,19 @@ from __future__ import annotations
 import pytest
 
 from linecrew.scenarios import load
-from proto import BatteryFault, GpsFreeze, LinkDrop, MotorFailure, Point
+from proto import (
+    BatteryFault,
+    DrainFault,
+    GpsFreeze,
+    GripperFailure,
+    KillVehicle,
+    LinkDrop,
+    MotorFailure,
+    MoveWorker,
+    Point,
+)
 from proto.site import TimedPoint, Worker
-from sim_fleet.faults import UnknownVehicle, apply_fault
+from sim_fleet.faults import UnknownTarget, apply_fault
 from sim_fleet.from_proto import scenario_from_proto
 from sim_fleet.truth import sim_state
 from sim_fleet.workers import worker_position
@@ -24,7 +34,7 @@ def world():
 def test_battery_fault_sets_the_charge(world):
     reply = apply_fault(world, BatteryFault(uav_id="uav-1", fraction=0.25))
     assert world.vehicle("uav-1").battery.soc == pytest.approx(0.25)
-    assert reply.uav_id == "uav-1" and "25%" in reply.detail
+    assert reply.target == "uav-1" and "25%" in reply.detail
 
 
 def test_motor_link_and_gps_faults_reach_the_vehicle(world):
@@ -36,8 +46,21 @@ def test_motor_link_and_gps_faults_reach_the_vehicle(world):
     assert world.vehicle("uav-1").gps_frozen_until == pytest.approx(3)
 
 
+def test_drain_kill_gripper_and_worker_faults(world):
+    apply_fault(world, DrainFault(uav_id="uav-1", multiplier=3))
+    apply_fault(world, KillVehicle(uav_id="uav-2"))
+    apply_fault(world, GripperFailure(uav_id="uav-1"))
+    reply = apply_fault(world, MoveWorker(worker_id="W2", position=Point(x_m=1, y_m=2, z_m=3)))
+    assert world.vehicle("uav-1").drain_multiplier == 3
+    assert world.vehicle("uav-2").motors_failed and world.vehicle("uav-2").link_down_until > 1e9
+    assert world.vehicle("uav-1").gripper_failed
+    assert world.workers["W2"] == (1, 2, 3) and reply.target == "W2"
+    with pytest.raises(UnknownTarget, match="no worker 'W9'"):
+        apply_fault(world, MoveWorker(worker_id="W9", position=Point(x_m=0, y_m=0)))
+
+
 def test_unknown_uav_is_a_clear_error(world):
-    with pytest.raises(UnknownVehicle, match="known: uav-1, uav-2, uav-3") as caught:
+    with pytest.raises(UnknownTarget, match="known: uav-1, uav-2, uav-3") as caught:
         apply_fault(world, MotorFailure(uav_id="ghost"))
     assert caught.value.field == "uav_id"
 

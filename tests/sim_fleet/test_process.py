@@ -83,7 +83,7 @@ def test_faults_apply_and_show_in_the_ground_truth(sim):
     reply = client.query(
         KEYS.sim("fault"), BatteryFault(uav_id="uav-2", fraction=0.3), FaultApplied, 5.0
     )
-    assert reply.uav_id == "uav-2" and "30%" in reply.detail
+    assert reply.target == "uav-2" and "30%" in reply.detail
     state = client.query(KEYS.sim("state"), GetSimState(), SimState, 5.0)
     uav2 = next(v for v in state.vehicles if v.uav_id == "uav-2")
     assert uav2.battery_fraction == pytest.approx(0.3, abs=0.01)
@@ -125,3 +125,19 @@ def test_sigterm_stops_the_simulator_cleanly(sim):
     proc, _, _ = sim
     assert proc.stop() == 0
     assert "simulator stopped on SIGTERM" in proc.output()
+
+
+def test_fault_cli_acknowledges_and_reports_errors(sim, router):
+    import subprocess
+
+    base = [sys.executable, "-m", "sim_fleet", "fault", "--connect", router]
+    ok = subprocess.run(
+        [*base, "battery", "uav-3", "0.5"], capture_output=True, text=True, timeout=60
+    )
+    assert ok.returncode == 0 and "uav-3: battery set to 50%" in ok.stdout
+    bad = subprocess.run([*base, "kill", "uav-7"], capture_output=True, text=True, timeout=60)
+    assert bad.returncode == 1 and "not_found" in bad.stderr
+    invalid = subprocess.run(
+        [*base, "battery", "uav-3", "2"], capture_output=True, text=True, timeout=60
+    )
+    assert invalid.returncode == 2 and "fraction" in invalid.stderr
