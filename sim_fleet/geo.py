@@ -1,31 +1,29 @@
-"""Local ENU metres <-> geodetic lat/lon/alt around the site origin (pymap3d)."""
+"""The simulator's view of the site frame: tuples in, tuples out, with the
+conversion itself done by :class:`proto.geo.LocalFrame` (one implementation
+for every process)."""
 
 from __future__ import annotations
 
-import pymap3d
-
+from proto.geo import GeoPoint, LocalFrame, Point
 from sim_fleet.scenario import GeoOrigin, Vec3
 
 
 class GeoFrame:
-    """Converts between the site's ENU frame and WGS84 (degrees, metres AMSL-ish).
-
-    ``alt`` is ellipsoidal height in pymap3d; the simulator treats it as the
-    MAVLink AMSL altitude, which is consistent as long as both directions go
-    through this class.
-    """
+    """ENU metres <-> WGS84 around ``origin``. ``alt`` is the ellipsoidal height,
+    used as the MAVLink AMSL altitude consistently in both directions."""
 
     def __init__(self, origin: GeoOrigin) -> None:
         self.origin = origin
+        self._frame = LocalFrame(
+            GeoPoint(lat_deg=origin.lat_deg, lon_deg=origin.lon_deg, alt_m=origin.alt_m)
+        )
 
     def to_geodetic(self, enu: Vec3) -> tuple[float, float, float]:
         """ENU metres -> (lat_deg, lon_deg, alt_m)."""
-        o = self.origin
-        lat, lon, alt = pymap3d.enu2geodetic(*enu, o.lat_deg, o.lon_deg, o.alt_m)
-        return float(lat), float(lon), float(alt)
+        geo = self._frame.to_geodetic(Point(x_m=enu[0], y_m=enu[1], z_m=enu[2]))
+        return geo.lat_deg, geo.lon_deg, geo.alt_m
 
     def to_enu(self, lat_deg: float, lon_deg: float, alt_m: float) -> Vec3:
         """(lat_deg, lon_deg, alt_m) -> ENU metres."""
-        o = self.origin
-        e, n, u = pymap3d.geodetic2enu(lat_deg, lon_deg, alt_m, o.lat_deg, o.lon_deg, o.alt_m)
-        return float(e), float(n), float(u)
+        p = self._frame.to_local(GeoPoint(lat_deg=lat_deg, lon_deg=lon_deg, alt_m=alt_m))
+        return p.x_m, p.y_m, p.z_m
