@@ -6,6 +6,7 @@ from __future__ import annotations
 import argparse
 import asyncio
 import contextlib
+import os
 import signal
 import threading
 
@@ -23,6 +24,12 @@ def common_parser(prog: str, description: str) -> argparse.ArgumentParser:
     parser.add_argument("--listen", action="append", help="zenoh endpoint to listen on")
     parser.add_argument("--zenoh-config", help="a zenoh json5 config file applied first")
     parser.add_argument("--lease-ms", type=int, help="zenoh transport lease (ms)")
+    parser.add_argument(
+        "--speedup",
+        type=float,
+        default=float(os.environ.get("LINECREW_SPEEDUP", "1")),
+        help="mission seconds per wall second; the same for every process of a run",
+    )
     parser.add_argument("--log-level", default="info", help="debug, info, warning, error")
     parser.add_argument("--log-format", choices=["plain", "json"], default="plain")
     return parser

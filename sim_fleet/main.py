@@ -66,7 +66,6 @@ def main(argv: list[str] | None = None) -> int:
         return fault_main(argv[1:])
     parser = common_parser("linecrew sim", "MAVLink fleet simulator with a human tracker")
     parser.add_argument("--scenario", default="paper", help="shipped scenario name or file")
-    parser.add_argument("--speedup", type=float, default=1.0, help="simulated s per wall s")
     parser.add_argument(
         "--base-port",
         type=int,
