@@ -14,11 +14,23 @@ COMMANDS: dict[str, tuple[str, str]] = {
     "router": ("ground_station.router:main", "run the ground site's Zenoh router"),
     "ground-station": ("ground_station.main:main", "run the mission manager and planner"),
     "sim": ("sim_fleet.main:main", "run the MAVLink fleet simulator and human tracker"),
+    "gateway": ("ground_station.gateway.main:main", "run the operator REST API"),
+    "up": ("linecrew.launch.up:main", "run router, ground station, gateway, sim and agents"),
+    "demo": ("linecrew.launch.demo:main", "the paper's scenario end to end"),
+    "submit": ("linecrew.client.commands:submit_main", "submit inspect / monitor / deliver"),
+    "gesture": ("linecrew.client.commands:gesture_main", "submit a crew gesture"),
+    "actions": ("linecrew.client.commands:actions_main", "list actions"),
+    "cancel": ("linecrew.client.commands:cancel_main", "cancel an action"),
+    "status": ("linecrew.client.commands:status_main", "fleet table"),
+    "plan": ("linecrew.client.commands:plan_main", "live plan timeline, or plan a PROBLEM file"),
+    "events": ("linecrew.client.commands:events_main", "follow ground-station events"),
+    "fault": ("linecrew.client.commands:fault_main", "inject a simulator fault (gateway)"),
 }
 BENCHES: dict[str, tuple[str, str]] = {
     "bus": ("linecrew.bus.bench:main", "Zenoh bus latency, throughput, liveliness"),
     "ground-station": ("ground_station.bench:main", "event-to-plan latency, loss detection"),
     "sim": ("sim_fleet.bench:main", "simulator physics rate, telemetry rate, CPU"),
+    "planner": ("ground_station.planner.cli:bench_main", "planner speed and plan quality"),
 }
 
 

@@ -6,7 +6,16 @@ import importlib
 
 import pytest
 
-PACKAGES = ["proto", "linecrew.bus"]
+PACKAGES = [
+    "proto",
+    "linecrew.bus",
+    "ground_station.store",
+    "ground_station.gateway",
+    "ground_station.planner",
+    "onboard_agent",
+    "onboard_agent.autopilot",
+    "sim_fleet",
+]
 
 
 @pytest.mark.parametrize("name", PACKAGES)

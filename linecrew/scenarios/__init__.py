@@ -43,7 +43,7 @@ def load(name_or_path: str) -> Scenario:
 
 def with_fleet_size(scenario: Scenario, uavs: int) -> Scenario:
     """``scenario`` with ``uavs`` UAVs cycling through its types and stations
-    (ids ``uav-00``...), for benchmarks and scale tests."""
+    (ids ``uav-00``...), for benchmarks and scale tests. Scripted actions stay."""
     types = [t.name for t in scenario.fleet.types]
     stations = [s.id for s in scenario.site.stations]
     specs = [
@@ -53,9 +53,7 @@ def with_fleet_size(scenario: Scenario, uavs: int) -> Scenario:
         for i in range(uavs)
     ]
     fleet = msgspec.structs.replace(scenario.fleet, uavs=specs)
-    return msgspec.structs.replace(
-        scenario, name=f"{scenario.name}-x{uavs}", fleet=fleet, actions=[]
-    )
+    return msgspec.structs.replace(scenario, name=f"{scenario.name}-x{uavs}", fleet=fleet)
 
 
 def parse(data: bytes, *, json: bool = False, source: str = "<scenario>") -> Scenario:

@@ -1,0 +1,248 @@
+"""``linecrew bench ground-station``: the ground station process measured
+with N light agents over a real router on loopback.
+
+1. Event -> new plan received: an operator submits an action; the time until
+   every agent whose plan changed has received it (p50 / p99 over events).
+2. Silence -> lost -> replan: an agent process is ``kill -9``ed; the time
+   until the ground station announces it lost and replans, against the
+   configured ``--link-timeout``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import pathlib
+import random
+import subprocess
+import sys
+import tempfile
+import threading
+import time
+from collections.abc import Callable
+
+import msgspec
+
+from ground_station.light_agent import LightAgent
+from linecrew.bus import Bus, BusConfig
+from linecrew.bus.router_process import router_process
+from linecrew.scenarios import load, with_fleet_size
+from proto import (
+    ActionReply,
+    EventKind,
+    GsEvent,
+    InspectAction,
+    KeySpace,
+    Point,
+    Role,
+    Scenario,
+    SubmitAction,
+    WaypointSpec,
+)
+
+
+def _inspection(rng: random.Random, index: int) -> SubmitAction:
+    waypoints = [
+        WaypointSpec(
+            position=Point(
+                x_m=rng.uniform(-15, 10), y_m=rng.uniform(0, 20), z_m=rng.uniform(3, 18)
+            ),
+            service_s=5.0,
+        )
+        for _ in range(3)
+    ]
+    return SubmitAction(request_id=f"bench-{index}", action=InspectAction(waypoints=waypoints))
+
+
+class _EventWatch:
+    """Collects ground-station events with their arrival times."""
+
+    def __init__(self, bus: Bus, keys: KeySpace) -> None:
+        self.items: list[tuple[float, GsEvent]] = []
+        self._cond = threading.Condition()
+        bus.subscribe(keys.events(), GsEvent, self._on_event)
+
+    def _on_event(self, _key: str, event: GsEvent) -> None:
+        with self._cond:
+            self.items.append((time.perf_counter(), event))
+            self._cond.notify_all()
+
+    def wait_for(
+        self, predicate: Callable[[GsEvent], bool], timeout_s: float, since: float = 0.0
+    ) -> tuple[float, GsEvent] | None:
+        """The first (time, event) after ``since`` satisfying ``predicate``."""
+        deadline = time.monotonic() + timeout_s
+        with self._cond:
+            while True:
+                found = next(
+                    (item for item in self.items if item[0] >= since and predicate(item[1])), None
+                )
+                remaining = deadline - time.monotonic()
+                if found or remaining <= 0:
+                    return found
+                self._cond.wait(remaining)
+
+
+def _event_to_plan(
+    client: Bus,
+    keys: KeySpace,
+    agents: dict[str, LightAgent],
+    watch: _EventWatch,
+    events: int,
+    seed: int,
+) -> list[float]:
+    rng = random.Random(seed)
+    latencies = []
+    for i in range(events):
+        started = time.perf_counter()
+        client.query(keys.rpc("submit"), _inspection(rng, i), ActionReply, 10.0)
+        replan = watch.wait_for(lambda e: e.kind == EventKind.REPLAN, 10.0, since=started)
+        if replan is None:
+            continue
+        epoch = replan[1].epoch
+        changed = [
+            e.uav_id
+            for _, e in watch.items
+            if e.kind == EventKind.PLAN_CHANGED and e.epoch == epoch
+        ]
+        deadline = time.monotonic() + 10
+        arrivals = []
+        for uav_id in changed:
+            agent = agents.get(uav_id)
+            while agent and not any(p.epoch >= epoch for p in agent.plans):
+                if time.monotonic() > deadline:
+                    break
+                time.sleep(0.001)
+            if agent:
+                arrivals += [
+                    t for t, p in zip(agent.arrivals, agent.plans, strict=False) if p.epoch == epoch
+                ]
+        if arrivals:
+            latencies.append(max(arrivals) - started)
+    return latencies
+
+
+def doomed_agent(endpoint: str, scenario_file: str, uav_id: str, lease_ms: int) -> None:
+    """Child-process body: a light agent (token + 5 Hz telemetry) until killed."""
+    scenario = msgspec.json.decode(pathlib.Path(scenario_file).read_bytes(), type=Scenario)
+    agent = LightAgent(BusConfig(connect=(endpoint,), lease_ms=lease_ms), scenario, uav_id)
+    print("ready", flush=True)
+    threading.Event().wait()
+    agent.close()
+
+
+def _silence_to_lost(
+    endpoint: str,
+    scenario_file: str,
+    uav_id: str,
+    lease_ms: int,
+    watch: _EventWatch,
+) -> dict[str, float]:
+    code = (
+        f"from ground_station.bench import doomed_agent; "
+        f"doomed_agent({endpoint!r}, {scenario_file!r}, {uav_id!r}, {lease_ms})"
+    )
+    child = subprocess.Popen([sys.executable, "-c", code], stdout=subprocess.PIPE)
+    try:
+        child.stdout.readline()
+        back = watch.wait_for(lambda e: e.kind == EventKind.UAV_BACK and e.uav_id == uav_id, 20)
+        if back is None:
+            raise RuntimeError(f"{uav_id} never came up")
+        killed = time.perf_counter()
+        child.kill()
+        lost = watch.wait_for(lambda e: e.kind == EventKind.UAV_LOST and e.uav_id == uav_id, 30)
+        replan = watch.wait_for(
+            lambda e: e.kind == EventKind.REPLAN and f"{uav_id} lost" in e.detail, 30
+        )
+    finally:
+        child.kill()
+        child.wait()
+    return {
+        "lost_after_s": lost[0] - killed if lost else float("nan"),
+        "replanned_after_s": replan[0] - killed if replan else float("nan"),
+    }
+
+
+def run(uavs: int, events: int, link_timeout_s: float, lease_ms: int, seed: int) -> dict:
+    """Run both measurements; returns the numbers."""
+    scenario = with_fleet_size(load("paper"), uavs + 1)
+    keys = KeySpace(scenario.site.id)
+    with tempfile.TemporaryDirectory() as tmp, router_process(keys.site, lease_ms) as endpoint:
+        scenario_file = str(pathlib.Path(tmp) / "scenario.json")
+        pathlib.Path(scenario_file).write_bytes(msgspec.json.encode(scenario))
+        gs = subprocess.Popen(
+            [
+                sys.executable,
+                "-m",
+                "ground_station",
+                "--connect",
+                endpoint,
+                "--scenario",
+                scenario_file,
+                "--db",
+                str(pathlib.Path(tmp) / "gs.db"),
+                "--link-timeout",
+                str(link_timeout_s),
+                "--lease-ms",
+                str(lease_ms),
+                "--log-level",
+                "warning",
+            ]
+        )
+        config = BusConfig(connect=(endpoint,), lease_ms=lease_ms)
+        agents: dict[str, LightAgent] = {}
+        try:
+            with Bus.open(config) as client:
+                watch = _EventWatch(client, keys)
+                deadline = time.monotonic() + 20
+                while not client.alive(keys.all_alive(Role.GROUND_STATION)):
+                    if time.monotonic() > deadline:
+                        raise RuntimeError("ground station did not start")
+                    time.sleep(0.05)
+                for spec in scenario.fleet.uavs[:uavs]:
+                    agents[spec.id] = LightAgent(config, scenario, spec.id)
+                while not all(a.plans for a in agents.values()):
+                    time.sleep(0.01)
+                latencies = sorted(_event_to_plan(client, keys, agents, watch, events, seed))
+                lost = _silence_to_lost(
+                    endpoint, scenario_file, scenario.fleet.uavs[-1].id, lease_ms, watch
+                )
+        finally:
+            for agent in agents.values():
+                agent.close()
+            gs.terminate()
+            gs.wait(10)
+    p = lambda q: latencies[min(len(latencies) - 1, int(q * len(latencies)))] * 1e3  # noqa: E731
+    return {
+        "agents": uavs,
+        "events": len(latencies),
+        "event_to_plan_p50_ms": p(0.5) if latencies else float("nan"),
+        "event_to_plan_p99_ms": p(0.99) if latencies else float("nan"),
+        "link_timeout_s": link_timeout_s,
+        **lost,
+    }
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Entry point of ``linecrew bench ground-station``."""
+    parser = argparse.ArgumentParser(
+        prog="linecrew bench ground-station",
+        description=__doc__,
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
+    parser.add_argument("--uavs", type=int, default=20, help="light agents")
+    parser.add_argument("--events", type=int, default=50, help="actions submitted")
+    parser.add_argument("--link-timeout", type=float, default=5.0, help="gs_link_timeout (s)")
+    parser.add_argument("--lease-ms", type=int, default=500, help="zenoh transport lease")
+    parser.add_argument("--seed", type=int, default=1)
+    parser.add_argument("--json", action="store_true", help="print JSON")
+    args = parser.parse_args(argv)
+    results = run(args.uavs, args.events, args.link_timeout, args.lease_ms, args.seed)
+    if args.json:
+        print(json.dumps(results, indent=2))
+    else:
+        for name, value in results.items():
+            print(
+                f"{name:>24}  {value:.4g}" if isinstance(value, float) else f"{name:>24}  {value}"
+            )
+    return 0

@@ -1,0 +1,29 @@
+"""Settings of one ground station process, built once in ``main``."""
+
+from __future__ import annotations
+
+import dataclasses
+import os
+
+
+@dataclasses.dataclass(frozen=True, kw_only=True)
+class GsConfig:
+    """Ground-station settings (flags override ``LINECREW_GS_*`` variables)."""
+
+    scenario: str = "paper"  # shipped scenario name or a scenario file
+    db_path: str = "linecrew-gs.db"  # the SQLite store (created if missing)
+    gs_id: str = "gs"  # name of this ground station's liveliness token
+    link_timeout_s: float = 5.0  # silence before a UAV is lost; > the agents' 3 s
+    watchdog_period_s: float = 0.1  # how often the watchdog looks
+    battery_margin_fraction: float = 0.1  # battery below the plan by this much -> replan
+
+    @classmethod
+    def from_env(cls, **overrides: object) -> GsConfig:
+        """Defaults, then environment, then ``overrides`` (``None`` ignored)."""
+        values: dict[str, object] = {}
+        for field in dataclasses.fields(cls):
+            raw = os.environ.get(f"LINECREW_GS_{field.name.upper()}")
+            if raw is not None:
+                values[field.name] = float(raw) if field.type == "float" else raw
+        values.update({k: v for k, v in overrides.items() if v is not None})
+        return cls(**values)  # type: ignore[arg-type]

@@ -1,0 +1,129 @@
+"""The fleet watchdog: who is present, who is lost, what each UAV is doing.
+
+Presence comes from each agent's liveliness token plus the freshness of its
+telemetry. A UAV silent (token gone, or no telemetry) for less than
+``link_timeout_s`` is still present: brief drop-outs cause nothing. Longer,
+it is *lost* and its work goes to others; when token and telemetry return it
+is *back*. UAVs never heard since start-up begin as lost (without an event).
+Time is injected: :meth:`FleetMonitor.check` is called with the clock's now.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import enum
+
+from proto.rpc import UavOpState, UavState
+from proto.telemetry import AgentState, AgentStatus, FlightState, Telemetry
+
+_FROM_AGENT = {
+    AgentState.IDLE: UavOpState.IDLE,
+    AgentState.BUSY: UavOpState.BUSY,
+    AgentState.RECHARGING: UavOpState.RECHARGING,
+    AgentState.EMERGENCY: UavOpState.EMERGENCY,
+    AgentState.FAILED: UavOpState.FAILED,
+}
+
+
+class Change(enum.StrEnum):
+    """A presence change reported by :meth:`FleetMonitor.check`."""
+
+    LOST = "lost"
+    BACK = "back"
+
+
+@dataclasses.dataclass
+class _Uav:
+    token: bool = False
+    token_lost_s: float | None = None
+    heard_s: float | None = None  # last telemetry
+    lost: bool = True
+    lost_s: float | None = None
+    telemetry: Telemetry | None = None
+    status: AgentStatus | None = None
+
+
+class FleetMonitor:
+    """Tracks every UAV of the fleet; feed it tokens, telemetry and status."""
+
+    def __init__(self, uav_ids: list[str], link_timeout_s: float) -> None:
+        self.link_timeout_s = link_timeout_s
+        self._uavs = {uav_id: _Uav() for uav_id in uav_ids}
+
+    def known(self, uav_id: str) -> bool:
+        """Whether ``uav_id`` belongs to the fleet."""
+        return uav_id in self._uavs
+
+    def on_token(self, uav_id: str, alive: bool, now_s: float) -> None:
+        """The agent's liveliness token appeared or vanished."""
+        uav = self._uavs.get(uav_id)
+        if uav is None:
+            return
+        uav.token = alive
+        uav.token_lost_s = None if alive else now_s
+
+    def on_telemetry(self, telemetry: Telemetry, now_s: float) -> None:
+        """A telemetry sample arrived (stamped with the receiver's clock)."""
+        uav = self._uavs.get(telemetry.uav_id)
+        if uav is not None:
+            uav.telemetry = telemetry
+            uav.heard_s = now_s
+
+    def on_status(self, status: AgentStatus) -> None:
+        """An agent status arrived."""
+        uav = self._uavs.get(status.uav_id)
+        if uav is not None:
+            uav.status = status
+
+    def silence_s(self, uav_id: str, now_s: float) -> float:
+        """How long ``uav_id`` has been silent (``inf`` if never heard)."""
+        uav = self._uavs[uav_id]
+        if uav.heard_s is None:
+            return float("inf")
+        token_silence = 0.0 if uav.token else now_s - (uav.token_lost_s or now_s)
+        return max(token_silence, now_s - uav.heard_s)
+
+    def check(self, now_s: float) -> list[tuple[str, Change]]:
+        """Apply the timeout; return the UAVs that became lost or came back."""
+        changes: list[tuple[str, Change]] = []
+        for uav_id, uav in self._uavs.items():
+            silent = self.silence_s(uav_id, now_s) >= self.link_timeout_s
+            if silent and not uav.lost:
+                uav.lost, uav.lost_s = True, now_s
+                changes.append((uav_id, Change.LOST))
+            elif uav.lost and uav.token and not silent:
+                uav.lost, uav.lost_s = False, None
+                changes.append((uav_id, Change.BACK))
+        return changes
+
+    def available(self, uav_id: str) -> bool:
+        """Present and neither failed nor in emergency: can take work."""
+        return self.state(uav_id) in {UavOpState.IDLE, UavOpState.BUSY, UavOpState.RECHARGING}
+
+    def state(self, uav_id: str) -> UavOpState:
+        """The state operators see."""
+        uav = self._uavs[uav_id]
+        if uav.lost:
+            return UavOpState.LOST
+        if uav.telemetry is not None and uav.telemetry.flight_state == FlightState.CRASHED:
+            return UavOpState.FAILED
+        if uav.status is None:
+            return UavOpState.IDLE
+        return _FROM_AGENT[uav.status.state]
+
+    def telemetry(self, uav_id: str) -> Telemetry | None:
+        """The latest telemetry of ``uav_id``."""
+        return self._uavs[uav_id].telemetry
+
+    def status(self, uav_id: str) -> AgentStatus | None:
+        """The latest status of ``uav_id``."""
+        return self._uavs[uav_id].status
+
+    def snapshot(self) -> list[UavState]:
+        """Every UAV's state for a :class:`proto.rpc.FleetReply`."""
+        return [
+            UavState(
+                uav_id=uav_id, state=self.state(uav_id), telemetry=uav.telemetry, status=uav.status
+            )
+            for uav_id, uav in self._uavs.items()
+        ]

@@ -1,0 +1,215 @@
+"""The operator REST API (FastAPI). It talks to the ground station only over
+Zenoh RPC (:class:`GsClient`); bodies are decoded with msgspec into the
+proto types, so the wire contract is the API contract."""
+
+from __future__ import annotations
+
+import secrets
+import uuid
+from collections.abc import Awaitable, Callable
+from typing import Any
+
+import msgspec
+from fastapi import FastAPI, Request, Response
+from fastapi.responses import PlainTextResponse, StreamingResponse
+
+from ground_station.gateway.bodies import GestureBody, ModifyBody, SubmitEnvelope
+from ground_station.gateway.errors import (
+    HttpError,
+    decode_body,
+    error_response,
+    linecrew_error_handler,
+)
+from ground_station.gateway.event_stream import event_stream
+from ground_station.gateway.gestures import Vocabulary
+from ground_station.gateway.metrics import GatewayCounters, prometheus_text
+from ground_station.gateway.rpc import GsClient, to_json
+from ground_station.gateway.settings import GatewaySettings
+from proto.errors import LinecrewError
+from proto.mission import Action, ActionState
+from proto.rpc import (
+    ActionList,
+    ActionReply,
+    CancelAction,
+    FleetReply,
+    GetAction,
+    GetFleet,
+    GetMetrics,
+    GetPlans,
+    ListActions,
+    MetricsReply,
+    ModifyAction,
+    PlansReply,
+    SubmitAction,
+)
+from proto.sim import SimFault
+from proto.site import Site
+
+PUBLIC_PATHS = ("/healthz", "/docs", "/openapi.json", "/docs/oauth2-redirect")
+
+
+def create_app(
+    settings: GatewaySettings, client: GsClient, site: Site, vocabulary: Vocabulary
+) -> FastAPI:
+    """The gateway application over ``client``."""
+    app = FastAPI(
+        title="linecrew gateway",
+        version="1",
+        description="Operator API of a linecrew ground station.",
+    )
+    counters = GatewayCounters()
+    app.add_exception_handler(LinecrewError, linecrew_error_handler)
+
+    @app.middleware("http")
+    async def guard(request: Request, call_next: Callable[[Request], Awaitable[Response]]):
+        if not request.url.path.startswith(PUBLIC_PATHS):
+            sent = request.headers.get("authorization", "")
+            if not secrets.compare_digest(sent.encode(), f"Bearer {settings.token}".encode()):
+                counters.count(401)
+                return error_response("unauthorized", "missing or wrong bearer token")
+        length = request.headers.get("content-length")
+        if length and length.isdigit() and int(length) > settings.max_body_bytes:
+            counters.count(413)
+            return error_response(
+                "body_too_large", f"request body over {settings.max_body_bytes} bytes"
+            )
+        response = await call_next(request)
+        counters.count(response.status_code)
+        return response
+
+    def json(message: Any, status: int = 200) -> Response:
+        return Response(to_json(message), status_code=status, media_type="application/json")
+
+    async def body(request: Request) -> bytes:
+        data = b""
+        async for chunk in request.stream():
+            data += chunk
+            if len(data) > settings.max_body_bytes:
+                raise HttpError("body_too_large", "request body too large")
+        return data
+
+    async def submit(action: Action, request_id: str | None, action_id: str | None) -> Response:
+        request = SubmitAction(
+            request_id=request_id or str(uuid.uuid4()), action=action, action_id=action_id
+        )
+        reply = await client.call(request, ActionReply)
+        return json(reply.record, 201)
+
+    @app.post(
+        "/v1/actions",
+        status_code=201,
+        summary="Submit an inspect, monitor or deliver action",
+        openapi_extra=_body_schema(Action),
+    )
+    async def post_action(request: Request) -> Response:
+        raw = await body(request)
+        action = decode_body(raw, Action)
+        envelope = decode_body(raw, SubmitEnvelope)
+        request_id = envelope.request_id or request.headers.get("idempotency-key")
+        return await submit(action, request_id, envelope.action_id)
+
+    @app.get("/v1/actions", summary="List actions, optionally by state")
+    async def list_actions(state: str | None = None) -> Response:
+        states = [ActionState(s) for s in state.split(",")] if state else []
+        return json((await client.call(ListActions(states=states), ActionList)).records)
+
+    @app.get("/v1/actions/{action_id}", summary="One action")
+    async def get_action(action_id: str) -> Response:
+        return json((await client.call(GetAction(action_id=action_id), ActionReply)).record)
+
+    @app.patch(
+        "/v1/actions/{action_id}",
+        summary="Change an action's priority or parameters",
+        openapi_extra=_body_schema(ModifyBody),
+    )
+    async def patch_action(action_id: str, request: Request) -> Response:
+        change = decode_body(await body(request), ModifyBody)
+        modify = ModifyAction(
+            request_id=change.request_id or str(uuid.uuid4()),
+            action_id=action_id,
+            priority=change.priority,
+            action=change.action,
+        )
+        return json((await client.call(modify, ActionReply)).record)
+
+    @app.delete("/v1/actions/{action_id}", summary="Cancel an action")
+    async def delete_action(action_id: str) -> Response:
+        cancel = CancelAction(request_id=f"cancel-{action_id}", action_id=action_id)
+        return json((await client.call(cancel, ActionReply)).record)
+
+    @app.post(
+        "/v1/gestures",
+        status_code=201,
+        summary="Turn a crew gesture into an action",
+        openapi_extra=_body_schema(GestureBody),
+    )
+    async def post_gesture(request: Request) -> Response:
+        gesture = decode_body(await body(request), GestureBody)
+        action = vocabulary.action(gesture.gesture, gesture.target, site)
+        return await submit(action, gesture.request_id, None)
+
+    @app.get("/v1/fleet", summary="UAV states, batteries, positions, current tasks")
+    async def fleet() -> Response:
+        return json((await client.call(GetFleet(), FleetReply)).uavs)
+
+    @app.get("/v1/plan", summary="Every UAV's timed steps (for a Gantt chart)")
+    async def plan() -> Response:
+        plans = (await client.call(GetPlans(), PlansReply)).plans
+        return json(sorted(plans, key=lambda p: p.uav_id))
+
+    @app.get("/v1/events", summary="Ground-station events as Server-Sent Events")
+    async def events(request: Request, after_seq: int | None = None) -> StreamingResponse:
+        return StreamingResponse(
+            event_stream(client, request, after_seq), media_type="text/event-stream"
+        )
+
+    @app.post(
+        "/v1/sim/faults",
+        summary="Inject a fault into the simulator (simulation only)",
+        openapi_extra=_body_schema(SimFault),
+    )
+    async def post_fault(request: Request) -> Response:
+        fault = decode_body(await body(request), SimFault)
+        return json(await client.fault(fault))
+
+    @app.get("/healthz", summary="Gateway liveness and whether the ground station is up")
+    async def healthz() -> Response:
+        up = client.ground_station_up()
+        return json({"status": "ok", "ground_station": "up" if up else "down"})
+
+    @app.get("/metrics", summary="Prometheus metrics", response_class=PlainTextResponse)
+    async def metrics() -> PlainTextResponse:
+        try:
+            values = (await client.call(GetMetrics(), MetricsReply)).values
+        except LinecrewError:
+            values = None
+        return PlainTextResponse(
+            prometheus_text(values, counters), media_type="text/plain; version=0.0.4"
+        )
+
+    _with_body_components(app)
+    return app
+
+
+BODY_TYPES = (Action, ModifyBody, GestureBody, SimFault)
+_SCHEMAS, _COMPONENTS = msgspec.json.schema_components(
+    BODY_TYPES, ref_template="#/components/schemas/{name}"
+)
+
+
+def _body_schema(body_type: Any) -> dict[str, Any]:
+    """OpenAPI ``requestBody`` from the msgspec type (bodies are decoded by msgspec)."""
+    schema = _SCHEMAS[BODY_TYPES.index(body_type)]
+    return {"requestBody": {"required": True, "content": {"application/json": {"schema": schema}}}}
+
+
+def _with_body_components(app: FastAPI) -> None:
+    """Add the msgspec body schemas to the generated OpenAPI document."""
+    generate = app.openapi
+
+    def openapi() -> dict[str, Any]:
+        spec = generate()
+        spec.setdefault("components", {}).setdefault("schemas", {}).update(_COMPONENTS)
+        return spec
+
+    app.openapi = openapi  # type: ignore[method-assign]

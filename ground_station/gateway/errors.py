@@ -1,0 +1,59 @@
+"""How linecrew errors become HTTP answers: one table from error code to
+status, one JSON shape ``{"error": code, "message": ..., "field": ...}``."""
+
+from __future__ import annotations
+
+import msgspec
+from fastapi import Request
+from fastapi.responses import JSONResponse
+
+from proto.errors import LinecrewError
+
+STATUS_BY_CODE: dict[str, int] = {
+    "invalid_action": 422,
+    "decode_error": 422,
+    "invalid_request": 422,
+    "invalid_key": 422,
+    "unknown_gesture": 422,
+    "not_found": 404,
+    "conflict": 409,
+    "invalid_transition": 409,
+    "request_timeout": 503,
+    "unavailable": 503,
+    "unauthorized": 401,
+    "body_too_large": 413,
+}
+
+
+class HttpError(LinecrewError):
+    """An error raised by the gateway itself (bad body, unknown gesture...)."""
+
+    def __init__(self, code: str, message: str, field: str | None = None, **extra: object):
+        super().__init__(message)
+        self.code = code
+        self.field = field
+        self.extra = extra
+
+
+def error_response(code: str, message: str, field: str | None = None, **extra: object):
+    """The JSON error answer for ``code``."""
+    body = {"error": code, "message": message, "field": field, **extra}
+    return JSONResponse(body, status_code=STATUS_BY_CODE.get(code, 500))
+
+
+async def linecrew_error_handler(_request: Request, exc: Exception) -> JSONResponse:
+    """FastAPI handler for every :class:`LinecrewError`."""
+    assert isinstance(exc, LinecrewError)
+    extra = getattr(exc, "extra", {})
+    return error_response(exc.code, exc.message, getattr(exc, "field", None), **extra)
+
+
+def decode_body(body: bytes, body_type: type) -> object:
+    """Decode a JSON body; a bad one is a 422 naming the field."""
+    try:
+        return msgspec.json.decode(body, type=body_type)
+    except msgspec.ValidationError as exc:
+        field = str(exc).rsplit("at `$.", 1)[-1].rstrip("`") if "at `$." in str(exc) else None
+        raise HttpError("invalid_request", str(exc), field=field) from exc
+    except msgspec.DecodeError as exc:
+        raise HttpError("invalid_request", f"body is not valid JSON: {exc}") from exc

@@ -1,0 +1,67 @@
+"""``linecrew gateway``: the operator REST API process."""
+
+from __future__ import annotations
+
+import asyncio
+import logging
+import sys
+
+import uvicorn
+
+from ground_station.gateway.app import create_app
+from ground_station.gateway.gestures import Vocabulary
+from ground_station.gateway.rpc import GsClient
+from ground_station.gateway.settings import GatewaySettings, resolve_token
+from linecrew.bus import Bus
+from linecrew.process import common_parser, start
+from linecrew.scenarios import ScenarioError, load
+from proto.errors import Unavailable
+from proto.keys import KeySpace, Role
+
+log = logging.getLogger("linecrew.gateway")
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Serve HTTP until SIGINT/SIGTERM; exit 1 on a fatal start-up error."""
+    parser = common_parser("linecrew gateway", "operator REST API of the ground station")
+    parser.add_argument("--host", default="127.0.0.1", help="HTTP bind address")
+    parser.add_argument("--port", type=int, default=8080, help="HTTP port")
+    parser.add_argument("--token", help="bearer token (else --token-file, LINECREW_TOKEN)")
+    parser.add_argument("--token-file", help="file holding the token (created if missing)")
+    parser.add_argument("--scenario", default="paper", help="site for gesture targets")
+    parser.add_argument("--gestures", help="a YAML gesture vocabulary")
+    parser.add_argument("--rpc-timeout", type=float, default=2.0, help="seconds before 503")
+    args = parser.parse_args(argv)
+    bus_config = start(args, "gateway")
+    try:
+        scenario = load(args.scenario)
+        vocabulary = Vocabulary.load(args.gestures)
+        bus = Bus.open(bus_config)
+    except (ScenarioError, Unavailable, OSError) as exc:
+        log.error("gateway cannot start: %s", exc)
+        return 1
+    settings = GatewaySettings(
+        host=args.host,
+        port=args.port,
+        site=scenario.site.id,
+        token=resolve_token(args.token, args.token_file),
+        rpc_timeout_s=args.rpc_timeout,
+        gestures=args.gestures,
+    )
+    with bus:
+        bus.declare_token(KeySpace(settings.site).alive(Role.GATEWAY, "gateway"))
+        client = GsClient(bus, settings.site, settings.rpc_timeout_s)
+        app = create_app(settings, client, scenario.site, vocabulary)
+        server = uvicorn.Server(
+            uvicorn.Config(
+                app, host=settings.host, port=settings.port, log_config=None, access_log=False
+            )
+        )
+        log.info("gateway on http://%s:%d", settings.host, settings.port)
+        asyncio.run(server.serve())
+    log.info("gateway stopped")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,162 @@
+"""Seeded instance generator: a power-line corridor.
+
+Towers every 250-350 m along a gently curving line, charging stations beside
+the line every few kilometres (a mix of battery swap and charging, 1-3
+pads), tool stations, a mix of physical / inspection / safety UAVs on small
+batteries (about 12-15 min of flight, so long jobs force recharges and
+monitoring forces hand-overs), and a mix of actions around the towers.
+Same arguments, same problem.
+"""
+
+from __future__ import annotations
+
+import random
+from math import sin
+
+from ground_station.planner.model import (
+    Action,
+    DeliverAction,
+    InspectAction,
+    MonitorAction,
+    Problem,
+    Station,
+    ToolStation,
+    Uav,
+    UavType,
+    Waypoint,
+)
+
+TOOLS = ("hammer", "wrench", "multimeter", "pliers", "insulator_tester")
+TYPES = (
+    UavType(
+        id="physical",
+        capabilities={"deliver": 0.0, "inspect": 1.0, "monitor": 1.0},
+        cruise_speed_mps=10.0,
+        battery_wh=70.0,
+        flight_power_w=300.0,
+        hover_power_w=280.0,
+    ),
+    UavType(
+        id="inspection",
+        capabilities={"inspect": 0.0, "monitor": 0.5},
+        cruise_speed_mps=14.0,
+        battery_wh=55.0,
+        flight_power_w=220.0,
+        hover_power_w=200.0,
+    ),
+    UavType(
+        id="safety",
+        capabilities={"monitor": 0.0, "inspect": 0.5},
+        cruise_speed_mps=12.0,
+        battery_wh=60.0,
+        flight_power_w=230.0,
+        hover_power_w=210.0,
+    ),
+)
+
+
+def generate(n_uavs: int, n_actions: int, seed: int = 0) -> Problem:
+    """A corridor problem with ``n_uavs`` UAVs and ``n_actions`` actions."""
+    rng = random.Random(seed * 1_000_003 + n_uavs * 1009 + n_actions)
+    n_towers = max(8, n_actions // 3 + 4, n_uavs * 2)
+    towers = []
+    x = 0.0
+    for i in range(n_towers):
+        x += rng.uniform(250.0, 350.0)
+        towers.append((x, 120.0 * sin(i / 7.0), rng.uniform(25.0, 40.0)))
+    length = towers[-1][0]
+    n_st = max(2, round(length / 2500.0) + 1)
+    stations = []
+    for i in range(n_st):
+        sx = length * i / (n_st - 1)
+        side = 80.0 if i % 2 else -80.0
+        swap = rng.random() < 0.4
+        stations.append(
+            Station(
+                id=f"S{i}",
+                position_m=(round(sx, 1), round(120.0 * sin(sx / 300.0 / 7.0) + side, 1), 0.0),
+                pads=rng.randint(1, 3),
+                recharge="swap" if swap else "charge",
+                swap_s=90.0,
+                full_charge_s=rng.choice((900.0, 1200.0)),
+            )
+        )
+    tool_stations = [
+        ToolStation(
+            id=f"T{i}",
+            position_m=(stations[i].position_m[0] + 30.0, stations[i].position_m[1], 2.0),
+            tools=TOOLS,
+        )
+        for i in range(0, n_st, 2)
+    ]
+    uavs = []
+    for i in range(n_uavs):
+        utype = TYPES[i % 3]
+        st = stations[(i * 7) % n_st]
+        uavs.append(
+            Uav(
+                id=f"U{i:02d}",
+                type=utype.id,
+                position_m=st.position_m,
+                home_station=st.id,
+                energy_wh=round(utype.battery_wh * rng.uniform(0.6, 1.0), 2),
+            )
+        )
+    actions: list[Action] = []
+    for i in range(n_actions):
+        r = rng.random()
+        weight = float(rng.randint(1, 5))
+        release = 0.0 if rng.random() < 0.7 else round(rng.uniform(0.0, 1800.0), 1)
+        centre = rng.randrange(n_towers)
+        if r < 0.5:
+            n_wp = rng.randint(3, min(10, n_towers))
+            start = max(0, min(centre, n_towers - n_wp))
+            wps = tuple(
+                Waypoint(
+                    position_m=(
+                        towers[j][0] + rng.uniform(-8, 8),
+                        towers[j][1] + 10.0,
+                        towers[j][2],
+                    ),
+                    service_s=float(rng.randint(20, 60)),
+                )
+                for j in range(start, start + n_wp)
+            )
+            actions.append(
+                InspectAction(id=f"A{i:03d}", weight=weight, release_s=release, waypoints=wps)
+            )
+        elif r < 0.8:
+            tx, ty, tz = towers[centre]
+            actions.append(
+                MonitorAction(
+                    id=f"A{i:03d}",
+                    weight=weight,
+                    release_s=release,
+                    worker_m=(tx, ty, tz - 5.0),
+                    k=rng.choice((1, 1, 2, 2, 3)) if n_uavs >= 6 else 1,
+                    standoff_m=10.0,
+                    duration_s=float(rng.choice((300, 600, 900, 1200))),
+                )
+            )
+        else:
+            tx, ty, tz = towers[centre]
+            ts = min(tool_stations, key=lambda s: abs(s.position_m[0] - tx))
+            actions.append(
+                DeliverAction(
+                    id=f"A{i:03d}",
+                    weight=weight,
+                    release_s=release,
+                    tool=rng.choice(TOOLS),
+                    tool_station=ts.id,
+                    worker_m=(tx, ty, tz - 5.0),
+                    pick_s=15.0,
+                    drop_s=20.0,
+                )
+            )
+    return Problem(
+        stations=tuple(stations),
+        tool_stations=tuple(tool_stations),
+        uav_types=TYPES,
+        uavs=tuple(uavs),
+        actions=tuple(actions),
+    )

@@ -1,0 +1,221 @@
+"""The paper's greedy made complete: queue, J1+J2+J3 allocation, splits.
+
+Actions are taken from the weight-ordered FCFS queue; each part goes to the
+UAV (and route position) with the lowest cost. Battery feasibility and
+recharges come from ``simulate``; monitoring lives in ``monitor``.
+"""
+
+from __future__ import annotations
+
+from math import dist
+
+from ground_station.planner import insertion, monitor
+from ground_station.planner.model import (
+    Action,
+    DeliverAction,
+    InspectAction,
+    MonitorAction,
+    Problem,
+    Vec3,
+)
+from ground_station.planner.routes import Ctx, Options, new_ctx, queue_order
+from ground_station.planner.simulate import State, Task
+from ground_station.planner.split import chunk, equal_chunks, fixed_split_count
+
+SPLITS_TRIED = 1
+"""How many split counts (best estimates first) are simulated per inspection."""
+RESOURCE_FACTOR = 0.3
+"""Weight of the UAV time an inspection split consumes when choosing how many
+UAVs share it (more UAVs finish sooner but take the fleet from later actions)."""
+
+
+def reachable(ctx: Ctx, kind: str, pos: Vec3, service_s: float) -> bool:
+    """Whether some capable UAV, on a full battery from the nearest station,
+    could do ``service_s`` at ``pos`` and get back above the reserve."""
+    d = ctx.site.nearest(pos)[0]
+    for r in ctx.routes.values():
+        k = r.kin
+        if kind not in k.caps:
+            continue
+        if k.capacity_wh - 2 * d * k.wh_per_m - k.hover_whps * service_s >= k.reserve_wh - 1e-6:
+            return True
+    return False
+
+
+def place_deliver(ctx: Ctx, a: DeliverAction) -> None:
+    if (a.id, None) in ctx.pinned:
+        return
+    if not ctx.capable("deliver"):
+        ctx.add_unplaced(a.id, None, "no_capable_uav")
+        return
+    ts = next(s for s in ctx.problem.tool_stations if s.id == a.tool_station)
+    if a.tool not in ts.tools:
+        ctx.add_unplaced(a.id, None, "unknown_tool")
+        return
+    if not (
+        reachable(ctx, "deliver", ts.position_m, a.pick_s)
+        and reachable(ctx, "deliver", a.worker_m, a.drop_s)
+    ):
+        ctx.add_unplaced(a.id, None, "unreachable_with_full_battery")
+        return
+
+    def make(st: State) -> list[Task]:
+        drop = Task("deliver", a.id, None, a.worker_m, a.drop_s, a.release_s, tool=a.tool)
+        if st.tool == a.tool:
+            return [drop]
+        pick = Task("pick", a.id, None, ts.position_m, a.pick_s, a.release_s, tool=a.tool)
+        return [pick, drop]
+
+    choice, reason = insertion.best_insertion(
+        ctx,
+        "deliver",
+        a.id,
+        ts.position_m,
+        a.pick_s + a.drop_s,
+        a.release_s,
+        make,
+        end=a.worker_m,
+        path_m=dist(ts.position_m, a.worker_m),
+    )
+    if choice is None:
+        ctx.add_unplaced(a.id, None, reason)
+    else:
+        insertion.apply(ctx, choice)
+
+
+def _place_chunk(ctx: Ctx, a: InspectAction, idx: list[int]) -> tuple[float, float]:
+    """Place one contiguous chunk; returns (finish, added UAV time).
+
+    A chunk no UAV can take whole is placed waypoint by waypoint; waypoints
+    no UAV can take are reported unplaced.
+    """
+    wps = a.waypoints
+    tasks = [
+        Task("inspect", a.id, i, wps[i].position_m, wps[i].service_s, a.release_s) for i in idx
+    ]
+    work = sum(t.service_s for t in tasks)
+    path = sum(dist(tasks[i - 1].pos, tasks[i].pos) for i in range(1, len(tasks)))
+    choice, _ = insertion.best_insertion(
+        ctx,
+        "inspect",
+        a.id,
+        tasks[0].pos,
+        work,
+        a.release_s,
+        lambda st: tasks,
+        end=tasks[-1].pos,
+        path_m=path,
+    )
+    if choice is not None:
+        before = ctx.routes[choice.uid].tail().t
+        insertion.apply(ctx, choice)
+        return choice.finish_s, ctx.routes[choice.uid].tail().t - before
+    finish, used = ctx.problem.now_s, 0.0
+    if len(idx) == 1:
+        ctx.add_unplaced(a.id, idx[0], "battery_infeasible")
+        return finish, used
+    for i in idx:
+        f, u = _place_chunk(ctx, a, [i])
+        finish, used = max(finish, f), used + u
+    return finish, used
+
+
+def place_inspect(ctx: Ctx, a: InspectAction, only: list[int] | None = None) -> None:
+    skip = set(a.done) | {i for aid, i in ctx.pinned if aid == a.id}
+    idx = [i for i in (only if only is not None else range(len(a.waypoints))) if i not in skip]
+    if not idx:
+        return
+    caps = ctx.capable("inspect")
+    if not caps:
+        for i in idx:
+            ctx.add_unplaced(a.id, i, "no_capable_uav")
+        return
+    ok = []
+    for i in idx:
+        wp = a.waypoints[i]
+        if reachable(ctx, "inspect", wp.position_m, wp.service_s):
+            ok.append(i)
+        else:
+            ctx.add_unplaced(a.id, i, "unreachable_with_full_battery")
+    if not ok:
+        return
+    pts = [a.waypoints[i].position_m for i in ok]
+    serv = [a.waypoints[i].service_s for i in ok]
+    speed = min(ctx.routes[u].kin.speed_mps for u in caps)
+    if ctx.options.mode == "paper":
+        for c in equal_chunks(len(ok), min(fixed_split_count(len(ok)), len(caps))):
+            _place_chunk(ctx, a, [ok[j] for j in c])
+        return
+    max_split = min(2, ctx.options.max_split) if ctx.fast else ctx.options.max_split
+    splits = {
+        m: chunk(pts, serv, speed, m) for m in range(1, min(max_split, len(caps), len(ok)) + 1)
+    }
+    # Simulate only the SPLITS_TRIED most promising split counts (by estimate).
+    ranked = sorted(splits, key=lambda m: (_estimate(ctx, a, ok, splits[m], caps), m))
+    tried = sorted(ranked[:SPLITS_TRIED])
+    if len(tried) == 1:
+        for c in splits[tried[0]]:
+            _place_chunk(ctx, a, [ok[j] for j in c])
+        return
+    snap = ctx.snapshot()
+    best: tuple[float, tuple] | None = None
+    for m in tried:
+        finish, used = ctx.problem.now_s, 0.0
+        for c in splits[m]:
+            f, u = _place_chunk(ctx, a, [ok[j] for j in c])
+            finish, used = max(finish, f), used + u
+        score = finish + RESOURCE_FACTOR * used + 1e6 * len(ctx.unplaced.get(a.id, ()))
+        if best is None or score < best[0]:
+            best = (score, ctx.snapshot())
+        ctx.restore(snap)
+    assert best is not None
+    ctx.restore(best[1])
+
+
+def _estimate(
+    ctx: Ctx, a: InspectAction, ok: list[int], chunks: list[list[int]], caps: list[str]
+) -> float:
+    """Cheap score of a split: each chunk on the UAV that could finish it
+    first (tails only, no battery), as ``place_inspect`` scores real splits."""
+    wps = a.waypoints
+    taken: set[str] = set()
+    finish, used = ctx.problem.now_s, 0.0
+    for c in chunks:
+        pts = [wps[ok[j]].position_m for j in c]
+        work = sum(wps[ok[j]].service_s for j in c)
+        path = sum(dist(pts[i - 1], pts[i]) for i in range(1, len(pts)))
+        best = None
+        for uid in caps:
+            if uid in taken:
+                continue
+            r = ctx.routes[uid]
+            st = r.tail()
+            k = r.kin
+            fin = max(st.t + dist(st.pos, pts[0]) / k.speed_mps, a.release_s)
+            fin += work + path / k.speed_mps
+            cost = fin + ctx.weights.suitability_s * k.caps["inspect"]
+            if best is None or cost < best[0]:
+                best = (cost, fin, fin - st.t, uid)
+        if best is None:
+            return float("inf")
+        taken.add(best[3])
+        finish, used = max(finish, best[1]), used + best[2]
+    return finish + RESOURCE_FACTOR * used
+
+
+def place_action(ctx: Ctx, a: Action, only: list[int] | None = None) -> None:
+    """Place one action (or only some waypoints of an inspection)."""
+    if isinstance(a, InspectAction):
+        place_inspect(ctx, a, only)
+    elif isinstance(a, MonitorAction):
+        monitor.place_monitor(ctx, a)
+    else:
+        place_deliver(ctx, a)
+
+
+def build(problem: Problem, options: Options | None = None) -> Ctx:
+    """Run the heuristic over the whole queue; returns the planning state."""
+    ctx = new_ctx(problem, options or Options())
+    for a in queue_order(problem.actions):
+        place_action(ctx, a)
+    return ctx

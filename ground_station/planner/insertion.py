@@ -1,0 +1,152 @@
+"""Cheapest insertion of a part (a few tasks) into some UAV's route.
+
+complete mode tries each capable UAV at the end of its route and in the idle
+gaps before its anchored (monitoring) tasks, ordered by a lower bound of the
+cost so most candidates are never simulated. paper mode only appends and
+ranks UAVs by the paper's distance cost.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from math import dist
+from typing import NamedTuple
+
+from ground_station.planner import costs
+from ground_station.planner.model import Vec3
+from ground_station.planner.routes import Ctx
+from ground_station.planner.simulate import Sim, State, Task
+
+MIN_GAP_S = 5.0
+MAX_EVAL = 6
+MAX_GAP_EVAL = 2
+MAX_ANYWHERE_EVAL = 4
+"""complete mode simulates at most this many candidates (best lower bounds)."""
+
+
+class Choice(NamedTuple):
+    cost: float
+    uid: str
+    pos: int
+    tasks: list[Task]
+    sim: Sim
+    finish_s: float
+    delay_s: float
+
+
+def gap_positions(ctx: Ctx, uid: str) -> list[int]:
+    """Indices of anchored tasks preceded by an idle gap worth filling (and,
+    while improving, every boundary between two actions)."""
+    r = ctx.routes[uid]
+    anywhere = ctx.anywhere
+    cache = r.gap_cache
+    if cache is not None and cache[0] is r.tasks and cache[1] == anywhere:
+        return cache[2]
+    out: list[int] = []
+    speed = r.kin.speed_mps
+    prev = None
+    for i, t in enumerate(r.tasks):
+        boundary = anywhere and prev is not None and t.action_id != prev and i > 0
+        prev = t.action_id
+        if t.anchor_s is None:
+            if boundary and (t.action_id, t.index) not in ctx.pinned:
+                out.append(i)
+            continue
+        st = r.state_before(i)
+        if t.anchor_s - st.t - dist(st.pos, t.pos) / speed > MIN_GAP_S:
+            out.append(i)
+    r.gap_cache = (r.tasks, anywhere, out)
+    return out
+
+
+def best_insertion(
+    ctx: Ctx,
+    kind: str,
+    action_id: str,
+    start: Vec3,
+    work_s: float,
+    release_s: float,
+    make: Callable[[State], list[Task]],
+    uids: list[str] | None = None,
+    end: Vec3 | None = None,
+    path_m: float = 0.0,
+) -> tuple[Choice | None, str]:
+    """Best (uid, position) for the tasks ``make(state)`` builds; or a reason.
+
+    ``work_s`` (service time) and ``path_m`` (flight inside the part) feed the
+    lower bounds that decide which candidates are simulated at all."""
+    uids = ctx.capable(kind) if uids is None else uids
+    if not uids:
+        return None, "no_capable_uav"
+    w = ctx.weights
+    now = ctx.problem.now_s
+    paper = ctx.options.mode == "paper"
+    cands: list[tuple[float, str, int]] = []
+    info: dict[str, tuple[float, float]] = {}
+    for uid in uids:
+        r = ctx.routes[uid]
+        kin = r.kin
+        suit = kin.caps[kind]
+        part_s = work_s + path_m / kin.speed_mps
+        jv = costs.j3(ctx.running.get(uid), action_id)
+        info[uid] = (suit, jv)
+        n = len(r.tasks)
+        positions = (n,) if paper else (n, *gap_positions(ctx, uid))
+        for pos in positions:
+            st = r.states[pos - 1] if pos > 0 else r.init
+            if paper:
+                lb = costs.paper_cost(w, suit, st, start, jv)
+            else:
+                d0 = dist(st.pos, start)
+                fin = st.t + d0 / kin.speed_mps
+                if fin < release_s:
+                    fin = release_s
+                fin += part_s
+                if pos < n:
+                    nxt = r.tasks[pos]
+                    back = dist(end or start, nxt.pos) / kin.speed_mps
+                    if nxt.anchor_s is not None and fin + back > nxt.anchor_s:
+                        continue
+                lb = costs.complete_cost(w, suit, fin, now, 0.0, jv)
+            cands.append((lb, uid, pos))
+    cands.sort()
+    best: Choice | None = None
+    reason = "battery_infeasible"
+    evaluated = gaps = 0
+    for lb, uid, pos in cands:
+        if evaluated >= (MAX_EVAL if best is not None else 3 * MAX_EVAL):
+            break
+        if best is not None and lb >= best.cost:
+            break
+        r = ctx.routes[uid]
+        if pos < len(r.tasks):
+            if gaps >= (MAX_ANYWHERE_EVAL if ctx.anywhere else MAX_GAP_EVAL):
+                continue
+            gaps += 1
+        else:
+            evaluated += 1
+        tasks = make(r.state_before(pos))
+        sim = ctx.try_insert(uid, pos, tasks)
+        if isinstance(sim, str):
+            if sim == "late":
+                reason = "battery_infeasible"
+            continue
+        finish = sim.states[len(tasks) - 1].t
+        if pos >= len(r.tasks) or sim.old_next >= 0:
+            delay = 0.0
+        else:
+            delay = max(0.0, sim.states[-1].t - r.tail().t)
+        if paper:
+            cost = lb
+        else:
+            suit, jv = info[uid]
+            cost = costs.complete_cost(w, suit, finish, now, delay, jv)
+        if best is None or cost < best.cost:
+            best = Choice(cost, uid, pos, tasks, sim, finish, delay)
+        if paper:
+            break
+    return best, reason
+
+
+def apply(ctx: Ctx, choice: Choice) -> None:
+    ctx.commit(choice.uid, choice.pos, choice.tasks, choice.sim)

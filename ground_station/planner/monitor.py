@@ -1,0 +1,195 @@
+"""Synchronised k-UAV monitoring with hand-over.
+
+A monitoring action needs ``k`` slots (stand-off positions around the
+worker) covered together from a common start ``T0`` for ``duration_s``.
+UAVs that arrive early wait (landed if they can) so all slots start at T0.
+Each slot is covered by a chain of segments: when a UAV's battery forces it
+to leave, another UAV arrives at or before that moment and takes the slot
+(the paper's Fig. 6), so coverage has no gap. Segments are tasks anchored
+at their start time; the UAV that left recharges in its own route.
+"""
+
+from __future__ import annotations
+
+import heapq
+from math import cos, dist, pi, sin
+
+from ground_station.planner import costs
+from ground_station.planner.energy import EPS_S
+from ground_station.planner.model import MonitorAction, Vec3
+from ground_station.planner.routes import Ctx
+from ground_station.planner.simulate import Task, monitor_reach
+
+MAX_T0_CANDIDATES = 2
+MAX_REACH = 5
+PUSH_PENALTY_S = 600.0
+"""Extra rank cost of a repair segment that delays a UAV's later tasks."""
+"""UAVs (best first by suitability and distance) examined for each segment."""
+
+
+def slot_position(a: MonitorAction, slot: int) -> Vec3:
+    """Stand-off position of ``slot``: bearing 2*pi*slot/k at the worker's height."""
+    x, y, z = a.worker_m
+    ang = 2 * pi * slot / a.k
+    return (x + a.standoff_m * cos(ang), y + a.standoff_m * sin(ang), z)
+
+
+def _cover(ctx: Ctx, a: MonitorAction, t0: float, uids: list[str]) -> float | None:
+    """Tentatively commit a full coverage from ``t0``; its cost, or None."""
+    end = t0 + a.duration_s
+    return _cover_needs(ctx, a, [(t0, s, end) for s in range(a.k)], uids)
+
+
+def _slot_position_in_route(ctx: Ctx, uid: str, pos: Vec3, t: float, push: bool) -> int | None:
+    """Where in ``uid``'s route a segment at ``pos`` from ``t`` can go: the
+    end if the UAV is free by then; with ``push``, the last position from
+    which it can still get there (delaying what follows); else None."""
+    r = ctx.routes[uid]
+    speed = r.kin.speed_mps
+    n = len(r.tasks)
+    st = r.tail()
+    if st.t + dist(st.pos, pos) / speed <= t + EPS_S:
+        return n
+    if not push:
+        return None
+    lo = 1 if n and (r.tasks[0].action_id, r.tasks[0].index) in ctx.pinned else 0
+    for p in range(n - 1, lo - 1, -1):
+        st = r.state_before(p)
+        if st.t + dist(st.pos, pos) / speed <= t + EPS_S:
+            return p
+    return None
+
+
+def _cover_needs(
+    ctx: Ctx,
+    a: MonitorAction,
+    needs: list[tuple[float, int, float]],
+    uids: list[str],
+    push: bool = False,
+) -> float | None:
+    """Commit segments covering each (from, slot, until) with hand-overs.
+    With ``push`` a segment may also go before a UAV's later tasks."""
+    min_seg = ctx.problem.min_monitor_segment_s
+    slots = [slot_position(a, s) for s in range(a.k)]
+    need = list(needs)
+    heapq.heapify(need)
+    end = max(e for _, _, e in needs)
+    w = ctx.weights
+    suit_sum = 0.0
+    handovers = 0
+    while need:
+        t, s, end = heapq.heappop(need)
+        pos = slots[s]
+        pre = []
+        for uid in uids:
+            p = _slot_position_in_route(ctx, uid, pos, t, push)
+            if p is None:
+                continue
+            r = ctx.routes[uid]
+            st = r.state_before(p)
+            travel_s = dist(st.pos, pos) / r.kin.speed_mps
+            suit = costs.j1(r.kin.caps, "monitor")
+            jv = costs.j3(ctx.running.get(uid), a.id)
+            penalty = 0.0 if p == len(r.tasks) else PUSH_PENALTY_S
+            pre.append(
+                (w.suitability_s * suit + w.interruption_s * jv + travel_s + penalty, uid, suit, p)
+            )
+        pre.sort()
+        ranked = []
+        for base, uid, suit, p in pre:
+            if len(ranked) >= MAX_REACH:
+                break
+            r = ctx.routes[uid]
+            st = r.state_before(p)
+            reach = monitor_reach(r.kin, ctx.site, ctx.pads, st, pos, t, (uid, st.t), end)
+            if reach is None:
+                continue
+            seg_end = min(end, reach)
+            if seg_end < end - EPS_S and seg_end - t < min_seg:
+                continue
+            ranked.append((base - (seg_end - t), uid, seg_end, suit, p))
+        ranked.sort()
+        for _, uid, seg_end, suit, p in ranked:
+            task = Task("monitor", a.id, s, pos, seg_end - t, a.release_s, anchor_s=t)
+            sim = ctx.try_insert(uid, p, [task])
+            if isinstance(sim, str):
+                continue
+            ctx.commit(uid, p, [task], sim)
+            suit_sum += suit * (seg_end - t) / a.duration_s
+            if seg_end < end - EPS_S:
+                heapq.heappush(need, (seg_end, s, end))
+                handovers += 1
+            break
+        else:
+            return None
+    return (
+        w.suitability_s * suit_sum + w.travel * (end - ctx.problem.now_s) * a.k + 10.0 * handovers
+    )
+
+
+def repair(ctx: Ctx, a: MonitorAction, gaps: list[tuple[float, int, float]]) -> bool:
+    """Cover the (from, slot, until) intervals a lost UAV leaves, without
+    touching the rest of the monitoring; False (unchanged) if impossible."""
+    snap = ctx.snapshot()
+    if _cover_needs(ctx, a, gaps, ctx.capable("monitor"), push=True) is not None:
+        return True
+    ctx.restore(snap)
+    return False
+
+
+def place_monitor(ctx: Ctx, a: MonitorAction) -> None:
+    uids = ctx.capable("monitor")
+    if not uids:
+        ctx.add_unplaced(a.id, None, "no_capable_uav")
+        return
+    if a.k > len(uids):
+        ctx.add_unplaced(a.id, None, "k_exceeds_fleet")
+        return
+    pos0 = slot_position(a, 0)
+    d = ctx.site.nearest(pos0)[0]
+    min_seg = min(ctx.problem.min_monitor_segment_s, a.duration_s)
+    if not any(
+        (k := ctx.routes[u].kin).capacity_wh - 2 * d * k.wh_per_m - k.hover_whps * min_seg
+        >= k.reserve_wh
+        for u in uids
+    ):
+        ctx.add_unplaced(a.id, None, "unreachable_with_full_battery")
+        return
+    base = max(a.release_s, ctx.problem.now_s)
+    arrivals = sorted(
+        max(base, r.tail().t + dist(r.tail().pos, pos0) / r.kin.speed_mps)
+        for r in (ctx.routes[u] for u in uids)
+    )
+    t0 = arrivals[a.k - 1]
+    horizon = ctx.weights.suitability_s
+    primary = [t0, *[x for x in arrivals[a.k :] if t0 < x <= t0 + horizon]][:MAX_T0_CANDIDATES]
+    if ctx.fast:
+        primary = primary[:2]
+    if ctx.options.mode == "paper":
+        primary = primary[:1]
+    fallback = [arrivals[j] for j in (a.k, a.k + 1, a.k + 3, a.k + 7) if j < len(arrivals)]
+    charge_s = max((s.full_charge_s for s in ctx.site.charging), default=0.0)
+    last = arrivals[-1]
+    fallback += [last, last + a.duration_s, last + charge_s, last + 2 * (a.duration_s + charge_s)]
+    if ctx.fast:
+        fallback = [*fallback[:1], last + a.duration_s, last + 2 * (a.duration_s + charge_s)]
+    snap = ctx.snapshot()
+    best: tuple[float, tuple] | None = None
+    tried: set[float] = set()
+    for group in (primary, fallback):
+        for t in group:
+            if t in tried:
+                continue
+            tried.add(t)
+            cost = _cover(ctx, a, t, uids)
+            if cost is not None and (best is None or cost < best[0]):
+                best = (cost, ctx.snapshot())
+            ctx.restore(snap)
+            if best is not None and group is fallback:
+                break
+        if best is not None:
+            break
+    if best is None:
+        ctx.add_unplaced(a.id, None, "monitor_coverage_infeasible")
+        return
+    ctx.restore(best[1])

@@ -1,0 +1,157 @@
+"""Recharge decisions: where to charge, for how long, and pad slots.
+
+A recharge detour flies to a station (landing to wait if no pad is free),
+charges to full (or partially, when an anchored task or a soft deadline
+leaves less time) and flies on. Hops chain recharges along the stations
+when a target is beyond one battery's range.
+"""
+
+from __future__ import annotations
+
+from math import dist
+from typing import NamedTuple
+
+from ground_station.planner.energy import (
+    EPS_S,
+    EPS_WH,
+    Kin,
+    Site,
+    energy_after_recharge,
+    recharge_time_s,
+)
+from ground_station.planner.model import Vec3
+from ground_station.planner.pads import Ignore, Pads
+from ground_station.planner.state import State
+
+PAD_WAIT_S = 300.0
+"""A recharge that waits longer than this for a pad makes us try every station."""
+
+
+class RcOption(NamedTuple):
+    si: int
+    wait_s: float
+    dur_s: float
+    e_before: float
+    e_charged: float
+    arrive_task: float
+    e_at_task: float
+
+
+def recharge_option(
+    k: Kin,
+    site: Site,
+    pads: Pads,
+    st: State,
+    target: Vec3,
+    release_s: float,
+    latest: float | None,
+    ign: Ignore,
+    target_wh: float | None = None,
+    only: int | None = None,
+    soft: float | None = None,
+) -> RcOption | None:
+    """Best recharge detour from ``st`` before flying to ``target``.
+
+    The UAV flies to a station (landing to wait if no pad is free), charges
+    (to full; or as much as fits before ``latest``, the required arrival at
+    ``target``; or, charge model, to ``target_wh`` plus the onward leg) and
+    flies on. Best = earliest arrival at ``target``, then most energy.
+    ``only`` restricts the choice to one station index. ``soft``: arrive by
+    then if a shorter (partial) charge allows it (keeps later anchored tasks
+    reachable).
+    """
+    first = site.candidates(st.pos, target) if only is None else [only]
+    best = _rc_best(k, site, pads, st, target, release_s, latest, ign, target_wh, soft, first)
+    if only is None and (best is None or best.wait_s > PAD_WAIT_S):
+        # Pads near by are busy (or out of reach): look at every station.
+        rest = [i for i in range(len(site.positions)) if i not in first]
+        other = _rc_best(k, site, pads, st, target, release_s, latest, ign, target_wh, soft, rest)
+        if other is not None and (
+            best is None
+            or (other.arrive_task, -other.e_at_task) < (best.arrive_task, -best.e_at_task)
+        ):
+            best = other
+    return best
+
+
+def _rc_best(
+    k: Kin,
+    site: Site,
+    pads: Pads,
+    st: State,
+    target: Vec3,
+    release_s: float,
+    latest: float | None,
+    ign: Ignore,
+    target_wh: float | None,
+    soft: float | None,
+    stations: list[int],
+) -> RcOption | None:
+    t, pos, e, _landed, _ = st
+    best: RcOption | None = None
+    for si in stations:
+        station = site.charging[si]
+        sp = site.positions[si]
+        d1 = dist(pos, sp)
+        ea = e - d1 * k.wh_per_m
+        if ea < k.reserve_wh - EPS_WH and d1 > 0.0:
+            continue
+        t_arr = t + d1 / k.speed_mps
+        tr2 = dist(sp, target) / k.speed_mps
+        dur = recharge_time_s(station, k.capacity_wh, ea)
+        if target_wh is not None and station.recharge == "charge":
+            want = min(k.capacity_wh, target_wh + tr2 * k.speed_mps * k.wh_per_m)
+            dur = min(dur, station.full_charge_s * max(0.0, want - ea) / k.capacity_wh)
+        if latest is None:
+            start = pads.earliest(si, t_arr, dur, ign)
+            if soft is not None and station.recharge == "charge":
+                cap = soft - tr2 - start
+                if EPS_S < cap < dur:
+                    dur = cap
+        else:
+            full, last = dur, latest - tr2
+            need = station.swap_s if station.recharge == "swap" else EPS_S
+            fit = pads.first_fit(
+                si, t_arr, last, lambda s, full=full, last=last: min(full, last - s), need, ign
+            )
+            if fit is None:
+                continue
+            start, dur = fit
+        charged = energy_after_recharge(station, k.capacity_wh, ea, dur)
+        arrive = max(start + dur + tr2, release_s)
+        if latest is not None:
+            if arrive > latest + EPS_S:
+                continue
+            arrive = latest
+        e_at = charged - tr2 * k.speed_mps * k.wh_per_m
+        cand = RcOption(si, start - t_arr, dur, ea, charged, arrive, e_at)
+        if best is None or (arrive, -e_at) < (best.arrive_task, -best.e_at_task):
+            best = cand
+    return best
+
+
+def emit_recharge(k: Kin, site: Site, st: State, rc: RcOption, steps: list, res: list) -> State:
+    """Append the flight to the pad (landing to wait for a free pad if needed)
+    and the recharge; returns the state on the pad."""
+    t, pos, _e, _landed, tool = st
+    station = site.charging[rc.si]
+    sp = site.positions[rc.si]
+    d1 = dist(pos, sp)
+    arr = t + d1 / k.speed_mps
+    if rc.wait_s > EPS_S:
+        steps.append(("wait", t, arr, arr + rc.wait_s, rc.e_before, sp, None, None, None, None, d1))
+        t, arr, d1 = arr + rc.wait_s, arr + rc.wait_s, 0.0
+    end = arr + rc.dur_s
+    steps.append(("recharge", t, arr, end, rc.e_charged, sp, None, None, station.id, None, d1))
+    res.append((rc.si, arr, end))
+    return State(end, sp, rc.e_charged, True, tool)
+
+
+def next_hop(k: Kin, site: Site, st: State, target: Vec3) -> int | None:
+    """The reachable charging station nearest ``target`` and nearer than us."""
+    best, best_d = None, dist(st.pos, target) - 1.0
+    for si, sp in enumerate(site.positions):
+        d = dist(sp, target)
+        if d < best_d and st.e - dist(st.pos, sp) * k.wh_per_m >= k.reserve_wh - EPS_WH:
+            best, best_d = si, d
+    return best

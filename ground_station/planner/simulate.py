@@ -1,0 +1,272 @@
+"""Turn one UAV's ordered task list into timed steps, inserting waits and
+recharges so the battery never goes below the reserve.
+
+A task is an abstract job (one inspection waypoint, one monitoring segment,
+a pick, a drop). Waits are inserted before a task's release time or before
+an anchored task (a monitoring segment must start exactly at ``anchor_s``);
+a recharge is inserted before a task when doing it directly would leave the
+UAV unable to reach the nearest charging station above the reserve, or when
+an airborne UAV would otherwise hover idle for long.
+"""
+
+from __future__ import annotations
+
+from math import dist
+
+from ground_station.planner.energy import EPS_S, EPS_WH, Kin, Site
+from ground_station.planner.model import Vec3
+from ground_station.planner.pads import Ignore, Pads
+from ground_station.planner.recharge import emit_recharge, next_hop, recharge_option
+from ground_station.planner.state import Fail, Sim, State, Task
+
+__all__ = ["Fail", "Sim", "State", "Task", "advance", "home_steps", "monitor_reach", "simulate"]
+
+MAX_HOPS = 12
+LONG_WAIT_S = 120.0
+"""An airborne UAV facing a longer idle wait lands to recharge if it can."""
+
+
+def _service_end_e(k: Kin, e_at: float, service_s: float) -> float:
+    return e_at - k.hover_whps * service_s
+
+
+def advance(
+    k: Kin,
+    site: Site,
+    pads: Pads,
+    st: State,
+    task: Task,
+    steps: list,
+    res: list,
+    ign: Ignore,
+    depth: int = 0,
+    soft: float | None = None,
+) -> State | str:
+    """Schedule ``task`` after ``st``; returns the new state or a reason code."""
+    t, pos, e, landed, tool = st
+    if task.kind == "pick" and tool is not None:
+        return "tool_busy"
+    if task.kind == "deliver" and tool != task.tool:
+        return "tool_missing"
+    d = dist(pos, task.pos)
+    tr = d / k.speed_mps
+    ret_e = site.nearest(task.pos)[0] * k.wh_per_m
+    arr = t + tr
+    if task.release_s > arr:
+        arr = task.release_s
+    anchor = task.anchor_s
+    if anchor is not None:
+        if arr > anchor + EPS_S:
+            return "late"
+        arr = anchor
+    wait = arr - tr - t
+    if wait < EPS_S:
+        wait = 0.0
+    e_wait = e if landed else e - k.hover_whps * wait
+    e_at = e_wait - d * k.wh_per_m
+    e_end = _service_end_e(k, e_at, task.service_s)
+    direct_ok = e_end - ret_e >= k.reserve_wh - EPS_WH and e_wait >= k.reserve_wh - EPS_WH
+    rc = None
+    if not direct_ok or (wait > LONG_WAIT_S and not landed) or (task.topup and not landed):
+        rc = recharge_option(k, site, pads, st, task.pos, task.release_s, anchor, ign, soft=soft)
+        if rc is not None:
+            e_end_rc = _service_end_e(k, rc.e_at_task, task.service_s)
+            short = e_end_rc - ret_e < k.reserve_wh - EPS_WH
+            later = direct_ok and anchor is None and rc.arrive_task > arr + EPS_S
+            if short or (later and not task.topup):
+                rc = None
+        if rc is None and not direct_ok:
+            # Too far for one recharge: hop along stations towards the task.
+            if depth >= MAX_HOPS:
+                return "battery"
+            si = next_hop(k, site, st, task.pos)
+            if si is None:
+                return "battery"
+            hop = recharge_option(k, site, pads, st, site.positions[si], 0.0, None, ign, None, si)
+            if hop is None:
+                return "battery"
+            st = emit_recharge(k, site, st, hop, steps, res)
+            return advance(k, site, pads, st, task, steps, res, ign, depth + 1, soft)
+    if rc is not None:
+        st = emit_recharge(k, site, st, rc, steps, res)
+        arr = rc.arrive_task
+        tr = dist(st.pos, task.pos) / k.speed_mps
+        d = tr * k.speed_mps
+        wait = arr - tr - st.t
+        e_wait = st.e
+        e_at = rc.e_at_task
+        e_end = _service_end_e(k, e_at, task.service_s)
+        t, pos = st.t, st.pos
+    if wait > EPS_S:
+        steps.append(("wait", t, t, t + wait, e_wait, pos, None, None, None, None, 0.0))
+    end = arr + task.service_s
+    steps.append(
+        (
+            task.kind,
+            arr - tr,
+            arr,
+            end,
+            e_end,
+            task.pos,
+            task.action_id,
+            task.index,
+            None,
+            task.tool,
+            d,
+        )
+    )
+    if task.kind == "pick":
+        tool = task.tool
+    elif task.kind == "deliver":
+        tool = None
+    return State(end, task.pos, e_end, False, tool)
+
+
+def _deadlines(k: Kin, tasks: list[Task]) -> list[float | None]:
+    """Latest arrival at each task that still lets the UAV reach the next
+    anchored task in time (ignoring recharges); None if none follows."""
+    out: list[float | None] = [None] * len(tasks)
+    nxt: float | None = None
+    for i in range(len(tasks) - 1, -1, -1):
+        t = tasks[i]
+        if t.anchor_s is not None:
+            nxt = t.anchor_s
+        elif nxt is not None:
+            nxt -= t.service_s + dist(t.pos, tasks[i + 1].pos) / k.speed_mps
+        out[i] = nxt
+    return out
+
+
+def simulate(
+    k: Kin,
+    site: Site,
+    pads: Pads,
+    st: State,
+    tasks: list[Task],
+    ign: Ignore,
+    old: list[State] | None = None,
+    old_map: list[int] | None = None,
+) -> Sim | str:
+    """Simulate ``tasks`` from ``st``; a reason code (``Fail``) if one is
+    infeasible. With ``old``/``old_map`` (task i was task ``old_map[i]`` of
+    the route being edited, -1 if new), stops as soon as the state after a
+    task equals the old one: the rest of the old route is then unchanged."""
+    steps: list = []
+    res: list = []
+    states: list[State] = []
+    marks: list[int] = []
+    soft = _deadlines(k, tasks)
+    for i, task in enumerate(tasks):
+        marks.append(len(steps))
+        nxt = advance(k, site, pads, st, task, steps, res, ign, 0, soft[i])
+        if isinstance(nxt, str):
+            fail = Fail(nxt)
+            fail.index = i
+            return fail
+        states.append(nxt)
+        st = nxt
+        if old_map is not None and old is not None:
+            j = old_map[i]
+            if j >= 0:
+                o = old[j]
+                if (
+                    abs(o.t - nxt.t) < 1e-9
+                    and abs(o.e - nxt.e) < 1e-9
+                    and o.pos == nxt.pos
+                    and o.landed == nxt.landed
+                    and o.tool == nxt.tool
+                ):
+                    return Sim(steps, marks, states, res, j + 1)
+    return Sim(steps, marks, states, res)
+
+
+def monitor_reach(
+    k: Kin, site: Site, pads: Pads, st: State, pos: Vec3, anchor: float, ign: Ignore, need: float
+) -> float | None:
+    """Latest end a monitoring segment at ``pos`` starting at ``anchor`` can
+    last until on ``st``'s battery (direct, after a recharge, or after hops
+    along stations, as ``advance`` would fly it); None if the UAV cannot be
+    there at ``anchor``."""
+    for _ in range(MAX_HOPS + 1):
+        if st.t + dist(st.pos, pos) / k.speed_mps > anchor + EPS_S:
+            return None
+        best = _reach_once(k, site, pads, st, pos, anchor, ign, need)
+        if best is not None:
+            return best
+        si = next_hop(k, site, st, pos)
+        if si is None:
+            return None
+        hop = recharge_option(k, site, pads, st, site.positions[si], 0.0, None, ign, None, si)
+        if hop is None:
+            return None
+        t_pad = st.t + dist(st.pos, site.positions[si]) / k.speed_mps + hop.wait_s
+        st = State(t_pad + hop.dur_s, site.positions[si], hop.e_charged, True, st.tool)
+    return None
+
+
+def _reach_once(
+    k: Kin, site: Site, pads: Pads, st: State, pos: Vec3, anchor: float, ign: Ignore, need: float
+) -> float | None:
+    t, p, e, landed, _ = st
+    d = dist(p, pos)
+    tr = d / k.speed_mps
+    ret_e = site.nearest(pos)[0] * k.wh_per_m
+    hover = k.hover_whps if k.hover_whps > 0 else 1e-12
+    wait = anchor - tr - t
+    e_at = (e if landed else e - k.hover_whps * wait) - d * k.wh_per_m
+    best = None
+    if e_at - ret_e >= k.reserve_wh - EPS_WH and e_at + d * k.wh_per_m >= k.reserve_wh - EPS_WH:
+        best = anchor + (e_at - ret_e - k.reserve_wh) / hover
+    if best is None or best < need - EPS_S:
+        rc = recharge_option(k, site, pads, st, pos, 0.0, anchor, ign)
+        if rc is not None:
+            end_rc = anchor + (rc.e_at_task - ret_e - k.reserve_wh) / hover
+            if end_rc > anchor and (best is None or end_rc > best):
+                best = end_rc
+    return best
+
+
+def home_steps(k: Kin, site: Site, pads: Pads, st: State, ign: Ignore) -> tuple[list, list]:
+    """Steps that bring the UAV home (recharging first if needed)."""
+    steps: list = []
+    res: list = []
+    t, pos, e, landed, _tool = st
+    d = dist(pos, k.home_pos)
+    if landed and d < 1e-9:
+        return steps, res
+    if e - d * k.wh_per_m >= k.reserve_wh - EPS_WH:
+        end = t + d / k.speed_mps
+        steps.append(
+            ("home", t, end, end, e - d * k.wh_per_m, k.home_pos, None, None, k.home, None, d)
+        )
+        return steps, res
+    rc = recharge_option(k, site, pads, st, k.home_pos, 0.0, None, ign, k.reserve_wh + 1e-4)
+    if rc is not None and rc.e_at_task >= k.reserve_wh - EPS_WH:
+        st = emit_recharge(k, site, st, rc, steps, res)
+        d = dist(st.pos, k.home_pos)
+        end = st.t + d / k.speed_mps
+        steps.append(
+            ("home", st.t, end, end, rc.e_at_task, k.home_pos, None, None, k.home, None, d)
+        )
+        return steps, res
+    # Cannot get home: land at the nearest station (landing spots are not pads).
+    dn, si = site.nearest(pos)
+    if si >= 0:
+        sp = site.positions[si]
+        end = t + dn / k.speed_mps
+        steps.append(
+            (
+                "home",
+                t,
+                end,
+                end,
+                e - dn * k.wh_per_m,
+                sp,
+                None,
+                None,
+                site.charging[si].id,
+                None,
+                dn,
+            )
+        )
+    return steps, res

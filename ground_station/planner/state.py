@@ -1,0 +1,92 @@
+"""The planner's internal job and state records (see ``simulate``)."""
+
+from __future__ import annotations
+
+from typing import NamedTuple
+
+from ground_station.planner.model import Vec3
+
+
+class Task:
+    """One schedulable job on a UAV (see ``simulate``)."""
+
+    __slots__ = (
+        "action_id",
+        "anchor_s",
+        "index",
+        "kind",
+        "pos",
+        "release_s",
+        "service_s",
+        "tool",
+        "topup",
+    )
+
+    def __init__(
+        self,
+        kind: str,
+        action_id: str,
+        index: int | None,
+        pos: Vec3,
+        service_s: float,
+        release_s: float = 0.0,
+        anchor_s: float | None = None,
+        tool: str | None = None,
+    ) -> None:
+        self.kind = kind
+        self.action_id = action_id
+        self.index = index
+        self.pos = pos
+        self.service_s = service_s
+        self.release_s = release_s
+        self.anchor_s = anchor_s
+        self.tool = tool
+        self.topup = False  # recharge before this task if at all possible
+
+    def copy_topup(self) -> Task:
+        t = Task(
+            self.kind,
+            self.action_id,
+            self.index,
+            self.pos,
+            self.service_s,
+            self.release_s,
+            self.anchor_s,
+            self.tool,
+        )
+        t.topup = True
+        return t
+
+    def __repr__(self) -> str:
+        return f"Task({self.kind},{self.action_id},{self.index},{self.anchor_s})"
+
+
+class Fail(str):
+    """A reason code that also says which task (index) failed."""
+
+    index: int = -1
+
+
+class State(NamedTuple):
+    """A UAV between tasks."""
+
+    t: float
+    pos: Vec3
+    e: float
+    landed: bool
+    tool: str | None
+
+
+# Internal step tuple: (kind, start, arrive, end, e_after, pos, action_id,
+# index, station_id, tool, distance_m)
+RawStep = tuple
+
+
+class Sim(NamedTuple):
+    """Simulated tasks: steps, per-task first-step index, states, reservations."""
+
+    steps: list[RawStep]
+    marks: list[int]
+    states: list[State]
+    res: list[tuple[int, float, float]]
+    old_next: int = -1  # converged: the old route from this task on is unchanged

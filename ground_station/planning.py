@@ -1,0 +1,284 @@
+"""The boundary between the mission manager and the pure planner library:
+wire-side state in, a planner ``Problem`` out; a planner ``Plan`` in,
+per-UAV wire ``Task`` lists out.
+
+Planner time is relative: the problem's ``now_s`` is 0 and a step's times
+are seconds from now; wire tasks carry absolute mission seconds.
+Task ids are derived from what a task is (``{action}.wp{i}-{j}``,
+``{action}.slot{s}``, ``{uav}.recharge{n}`` ...) so that a replan that
+leaves a UAV's work alone yields the same ids, and an agent keeps flying.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from collections.abc import Iterable
+
+from ground_station import planner as pl
+from proto.fleet import Fleet
+from proto.geo import Point
+from proto.mission import Action, ActionRecord, DeliverAction, InspectAction, MonitorAction
+from proto.plan import (
+    DeliverTask,
+    GoHomeTask,
+    InspectTask,
+    MonitorTask,
+    PickTask,
+    RechargeTask,
+    Task,
+    WaitTask,
+    Waypoint,
+)
+from proto.site import BatterySwap, ChargingStation, Site
+
+
+@dataclasses.dataclass(frozen=True)
+class UavNow:
+    """What the ground station knows of one UAV at planning time."""
+
+    uav_id: str
+    position: Point
+    energy_wh: float
+    available: bool
+    airborne: bool = False
+    tool: str | None = None
+    running_action: str | None = None
+
+
+def _xyz(p: Point) -> tuple[float, float, float]:
+    return (p.x_m, p.y_m, p.z_m)
+
+
+def build_problem(
+    site: Site,
+    fleet: Fleet,
+    uavs: Iterable[UavNow],
+    records: Iterable[ActionRecord],
+    now_s: float,
+    worker_positions: dict[str, Point] | None = None,
+) -> pl.Problem:
+    """The planner's view of the mission at ``now_s`` (mission seconds)."""
+    workers = {w.id: w.position for w in site.workers} | (worker_positions or {})
+    specs = {u.id: u for u in fleet.uavs}
+    return pl.Problem(
+        now_s=0.0,
+        reserve_fraction=fleet.reserve_fraction,
+        stations=tuple(
+            pl.Station(
+                id=s.id,
+                position_m=_xyz(s.position),
+                pads=s.pads,
+                recharge="swap" if isinstance(s.recharge, BatterySwap) else "charge",
+                swap_s=getattr(s.recharge, "swap_s", 60.0),
+                full_charge_s=getattr(s.recharge, "full_charge_s", 1800.0),
+            )
+            for s in site.stations
+        ),
+        tool_stations=tuple(
+            pl.ToolStation(
+                id=t.id, position_m=_xyz(t.position), tools=tuple(tool.name for tool in t.tools)
+            )
+            for t in site.tool_stations
+        ),
+        uav_types=tuple(
+            pl.UavType(
+                id=t.name,
+                capabilities={str(c): cost for c, cost in t.capabilities.items()},
+                cruise_speed_mps=t.cruise_speed_mps,
+                battery_wh=t.battery_wh,
+                flight_power_w=t.flight_power_w,
+                hover_power_w=t.hover_power_w,
+            )
+            for t in fleet.types
+        ),
+        uavs=tuple(
+            pl.Uav(
+                id=u.uav_id,
+                type=specs[u.uav_id].type,
+                position_m=_xyz(u.position),
+                home_station=specs[u.uav_id].home_station,
+                energy_wh=u.energy_wh,
+                tool=u.tool,
+                available=u.available,
+                airborne=u.airborne,
+                running=pl.RunningTask(action_id=u.running_action) if u.running_action else None,
+            )
+            for u in uavs
+        ),
+        actions=tuple(_action(r, workers, now_s) for r in records),
+    )
+
+
+def _action(record: ActionRecord, workers: dict[str, Point], now_s: float) -> pl.Action:
+    action = record.action
+    common = {
+        "id": record.action_id,
+        "weight": action.priority,
+        "release_s": max(0.0, action.release_s - now_s) if action.release_s else 0.0,
+    }
+    match action:
+        case InspectAction(waypoints=waypoints):
+            return pl.InspectAction(
+                **common,
+                waypoints=tuple(
+                    pl.Waypoint(position_m=_xyz(w.position), service_s=w.service_s)
+                    for w in waypoints
+                ),
+                done=tuple(record.waypoints_done),
+            )
+        case MonitorAction():
+            return pl.MonitorAction(
+                **common,
+                worker_m=_xyz(workers[action.worker_id]),
+                k=action.uavs,
+                standoff_m=action.standoff_m,
+                duration_s=max(1.0, action.duration_s - record.monitored_s),
+            )
+        case DeliverAction():
+            return pl.DeliverAction(
+                **common,
+                tool=action.tool,
+                tool_station=action.tool_station_id,
+                worker_m=_xyz(workers[action.worker_id]),
+                pick_s=action.pick_s,
+                drop_s=action.drop_s,
+            )
+    raise TypeError(f"unknown action {action!r}")
+
+
+def to_tasks(
+    uav_plan: pl.UavPlan,
+    site: Site,
+    fleet: Fleet,
+    records: dict[str, ActionRecord],
+    now_s: float,
+) -> list[Task]:
+    """One UAV's planner steps as wire tasks (absolute mission seconds)."""
+    capacity = fleet.type_of(uav_plan.uav_id).battery_wh
+    stations = {s.id: s for s in site.stations}
+    tasks: list[Task] = []
+    counts: dict[str, int] = {}
+    steps = list(uav_plan.steps)
+    i = 0
+    while i < len(steps):
+        step = steps[i]
+        times = {
+            "start_s": now_s + step.start_s,
+            "end_s": now_s + step.end_s,
+            "energy_after_wh": step.energy_after_wh,
+        }
+        record = records.get(step.action_id) if step.action_id else None
+        action = record.action if record else None
+        if step.kind == "inspect" and isinstance(action, InspectAction):
+            j = i
+            while (
+                j + 1 < len(steps)
+                and steps[j + 1].kind == "inspect"
+                and steps[j + 1].action_id == step.action_id
+            ):
+                j += 1
+            group = steps[i : j + 1]
+            times["end_s"] = now_s + group[-1].end_s
+            times["energy_after_wh"] = group[-1].energy_after_wh
+            tasks.append(
+                InspectTask(
+                    task_id=f"{step.action_id}.wp{group[0].index}-{group[-1].index}",
+                    action_id=step.action_id,
+                    waypoints=[
+                        Waypoint(
+                            index=s.index,
+                            position=action.waypoints[s.index].position,
+                            service_s=action.waypoints[s.index].service_s,
+                        )
+                        for s in group
+                    ],
+                    **times,
+                )
+            )
+            i = j + 1
+            continue
+        tasks.append(_simple_task(step, action, uav_plan.uav_id, stations, capacity, counts, times))
+        i += 1
+    return tasks
+
+
+def _simple_task(
+    step: pl.Step,
+    action: Action | None,
+    uav_id: str,
+    stations: dict[str, ChargingStation],
+    capacity: float,
+    counts: dict[str, int],
+    times: dict[str, float],
+) -> Task:
+    """A wire task for a planner step other than inspect."""
+
+    def ordinal(kind: str) -> int:
+        counts[kind] = counts.get(kind, 0) + 1
+        return counts[kind]
+
+    match step.kind:
+        case "monitor":
+            return MonitorTask(
+                task_id=f"{step.action_id}.slot{step.index}.{ordinal(f'm{step.action_id}')}",
+                action_id=step.action_id,
+                worker_id=action.worker_id,
+                slot=step.index,
+                slots=action.uavs,
+                standoff_m=action.standoff_m,
+                duration_s=max(0.001, step.end_s - step.arrive_s),
+                **times,
+            )
+        case "pick":
+            return PickTask(
+                task_id=f"{step.action_id}.pick",
+                action_id=step.action_id,
+                tool=action.tool,
+                tool_station_id=action.tool_station_id,
+                position=_point(step.position_m),
+                pick_s=action.pick_s,
+                **times,
+            )
+        case "deliver":
+            return DeliverTask(
+                task_id=f"{step.action_id}.drop",
+                action_id=step.action_id,
+                tool=action.tool,
+                worker_id=action.worker_id,
+                drop_s=action.drop_s,
+                **times,
+            )
+        case "recharge":
+            return RechargeTask(
+                task_id=f"{uav_id}.recharge{ordinal('recharge')}",
+                station_id=step.station,
+                position=stations[step.station].position,
+                until_fraction=min(1.0, step.energy_after_wh / capacity),
+                **times,
+            )
+        case "wait":
+            return WaitTask(
+                task_id=f"{uav_id}.wait{ordinal('wait')}", until_s=times["end_s"], **times
+            )
+        case "home":
+            return GoHomeTask(
+                task_id=f"{uav_id}.home",
+                station_id=step.station,
+                position=stations[step.station].position,
+                **times,
+            )
+    raise ValueError(f"planner step {step.kind!r} has no wire task")
+
+
+def _point(xyz: tuple[float, float, float]) -> Point:
+    return Point(x_m=xyz[0], y_m=xyz[1], z_m=xyz[2])
+
+
+def same_work(a: list[Task], b: list[Task]) -> bool:
+    """Whether two task lists ask the same of a UAV (ids in order, and wait
+    deadlines within a second): if so, nothing is re-sent."""
+    return _signature(a) == _signature(b)
+
+
+def _signature(tasks: list[Task]) -> list[tuple[str, int]]:
+    return [(t.task_id, round(t.until_s) if isinstance(t, WaitTask) else 0) for t in tasks]

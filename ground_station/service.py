@@ -1,0 +1,166 @@
+"""The ground station process: the mission manager wired to the bus.
+
+One asyncio loop does all the work; Zenoh callbacks only hand samples over.
+Inputs: agents' telemetry, status, outcomes and liveliness tokens; RPC
+queries on ``gs/rpc/{op}``; plan resync queries on ``uav/*/plan``. Outputs:
+plans on ``uav/{id}/plan``, events on ``gs/events``, the ``alive/gs/{id}``
+token. On start it rebuilds from the store; agents reappear, a replan follows.
+"""
+
+from __future__ import annotations
+
+import asyncio
+import logging
+import time
+from collections.abc import Callable
+from typing import Any
+
+from ground_station.config import GsConfig
+from ground_station.event_log import EventLog
+from ground_station.fleet_monitor import FleetMonitor
+from ground_station.missions import MissionManager
+from ground_station.replanner import Replanner
+from ground_station.store import Store
+from linecrew.bus import Bus
+from linecrew.process import Shutdown
+from proto.errors import RequestError
+from proto.keys import KeySpace, Role, UavTopic
+from proto.rpc import REQUEST_OPS, GetMetrics, GetPlans, MetricsReply, PlansReply, Reply, Request
+from proto.scenario import Scenario
+from proto.telemetry import AgentStatus, TaskOutcome, Telemetry
+
+log = logging.getLogger("linecrew.ground_station")
+
+
+class GroundStation:
+    """Builds the components and runs them until shutdown."""
+
+    def __init__(
+        self,
+        config: GsConfig,
+        scenario: Scenario,
+        bus: Bus,
+        clock: Callable[[], float] = time.time,
+    ) -> None:
+        self.config = config
+        self.bus = bus
+        self.clock = clock
+        self.keys = KeySpace(scenario.site.id)
+        self.store = Store(config.db_path)
+        self.monitor = FleetMonitor([u.id for u in scenario.fleet.uavs], config.link_timeout_s)
+        self.events = EventLog(self.store, lambda e: bus.publish(self.keys.events(), e), clock)
+        self.replanner = Replanner(
+            scenario=scenario,
+            store=self.store,
+            monitor=self.monitor,
+            events=self.events,
+            send=lambda plan: bus.publish(self.keys.plan(plan.uav_id), plan),
+        )
+        self.manager = MissionManager(
+            scenario=scenario,
+            store=self.store,
+            monitor=self.monitor,
+            events=self.events,
+            replanner=self.replanner,
+            clock=clock,
+            battery_margin_fraction=config.battery_margin_fraction,
+        )
+
+    async def run(self, shutdown: Shutdown) -> None:
+        """Serve until ``shutdown``; then undeclare everything and close the store."""
+        keys, bus = self.keys, self.bus
+        try:
+            for op in REQUEST_OPS:
+                bus.serve(keys.rpc(op), Request, self._rpc_handler(op))
+            bus.serve(keys.all_uavs(UavTopic.PLAN), GetPlans, self._plan_query)
+            telemetry = bus.subscribe_async(keys.all_uavs(UavTopic.TELEMETRY), Telemetry)
+            status = bus.subscribe_async(keys.all_uavs(UavTopic.STATUS), AgentStatus)
+            outcomes = bus.subscribe_async(keys.all_uavs(UavTopic.OUTCOME), TaskOutcome)
+            tokens = bus.watch_liveliness_async(keys.all_alive(Role.AGENT))
+            bus.declare_token(keys.alive(Role.GROUND_STATION, self.config.gs_id))
+            log.info(
+                "ground station up",
+                extra={
+                    "site": keys.site,
+                    "db": self.config.db_path,
+                    "actions": len(self.store.actions()),
+                },
+            )
+            async with asyncio.TaskGroup() as group:
+                tasks = [
+                    group.create_task(self._consume(telemetry, self._on_telemetry)),
+                    group.create_task(self._consume(status, self._on_status)),
+                    group.create_task(self._consume(outcomes, self._on_outcome)),
+                    group.create_task(self._consume(tokens, self._on_token)),
+                    group.create_task(self._watchdog()),
+                ]
+                await shutdown.wait_async()
+                for task in tasks:
+                    task.cancel()
+        finally:
+            self.store.close()
+
+    async def _consume(self, source: Any, handle: Callable[[str, Any], None]) -> None:
+        async for key, item in source:
+            try:
+                handle(key, item)
+            except Exception:
+                log.exception("failed to handle a message on %s", key)
+
+    def _on_telemetry(self, _key: str, telemetry: Telemetry) -> None:
+        if self.monitor.known(telemetry.uav_id):
+            self.monitor.on_telemetry(telemetry, time.monotonic())
+            self.manager.on_telemetry(telemetry)
+
+    def _on_status(self, _key: str, status: AgentStatus) -> None:
+        self.monitor.on_status(status)
+
+    def _on_outcome(self, _key: str, outcome: TaskOutcome) -> None:
+        if self.monitor.known(outcome.uav_id):
+            self.manager.on_outcome(outcome)
+
+    def _on_token(self, key: str, alive: bool) -> None:
+        parsed = self.keys.parse(key)
+        if parsed.ident is not None:
+            self.monitor.on_token(parsed.ident, alive, time.monotonic())
+
+    async def _watchdog(self) -> None:
+        while True:
+            try:
+                self.manager.on_fleet_changes(self.monitor.check(time.monotonic()))
+            except Exception:
+                log.exception("watchdog step failed")
+            await asyncio.sleep(self.config.watchdog_period_s)
+
+    def _rpc_handler(self, op: str) -> Callable[[Request], Reply]:
+        def handle(request: Request) -> Reply:
+            if request.op != op:
+                raise RequestError(f"a {request.op!r} request sent to {op!r}", code="wrong_op")
+            if isinstance(request, GetMetrics):
+                return MetricsReply(values=self.metrics())
+            return self.manager.handle(request)
+
+        return handle
+
+    def _plan_query(self, request: GetPlans) -> PlansReply:
+        plan = self.replanner.plans.get(request.uav_id or "")
+        return PlansReply(plans=[plan] if plan else [])
+
+    def metrics(self) -> dict[str, float]:
+        """Counters and timings in one place."""
+        stats, counters = self.replanner.stats, self.manager.counters
+        values: dict[str, float] = {
+            "replans": stats.count,
+            "replan_seconds_total": stats.total_s,
+            "replan_seconds_last": stats.last_s,
+            "plans_sent": stats.plans_sent,
+            "outcomes": counters.outcomes,
+            "stale_outcomes": counters.stale_outcomes,
+            "battery_replans": counters.battery_replans,
+            "epoch": self.store.counter("epoch"),
+            "bus_malformed": sum(self.bus.stats.malformed.values()),
+        }
+        for record in self.store.actions():
+            key = f"actions_{record.state}"
+            values[key] = values.get(key, 0) + 1
+        return values

@@ -1,0 +1,1 @@
+"""The operator CLI: ``linecrew submit|gesture|actions|cancel|status|plan|events|fault``."""

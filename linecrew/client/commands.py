@@ -1,0 +1,179 @@
+"""The operator commands of ``linecrew``: submit, gesture, actions, cancel,
+status, plan, events, fault. All go through the gateway over HTTP; ``--json``
+prints the raw answer instead of a table."""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+import time
+from collections.abc import Callable
+from typing import Any
+
+import msgspec
+from rich.console import Console
+
+from linecrew.client.gateway import Gateway, GatewayError, session
+from linecrew.client.render import actions_table, fleet_table, plan_timeline
+from linecrew.fault_kinds import add_fault_arguments, fault_from_args
+
+
+def _parser(prog: str, description: str) -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(prog=f"linecrew {prog}", description=description)
+    parser.add_argument("--url", help="gateway URL (else LINECREW_URL or the session file)")
+    parser.add_argument("--token", help="bearer token (else LINECREW_TOKEN or the session file)")
+    parser.add_argument("--json", action="store_true", help="print JSON")
+    return parser
+
+
+def _run(args: argparse.Namespace, work: Callable[[Gateway], Any], show: Callable[[Any], Any]):
+    url, token = session(args.url, args.token)
+    try:
+        result = work(Gateway(url, token))
+    except GatewayError as exc:
+        print(f"linecrew: {exc}", file=sys.stderr)
+        return 1
+    if args.json:
+        print(json.dumps(result, indent=2))
+    else:
+        Console().print(show(result))
+    return 0
+
+
+def _point(text: str) -> dict[str, float]:
+    try:
+        x, y, z, *rest = (float(v) for v in text.split(","))
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r}: expected X,Y,Z[,SERVICE_S]") from None
+    return {"position": {"x_m": x, "y_m": y, "z_m": z}, "service_s": rest[0] if rest else 0.0}
+
+
+def submit_main(argv: list[str]) -> int:
+    """``linecrew submit inspect|monitor|deliver ...``"""
+    parser = _parser("submit", "submit an action")
+    parser.add_argument("--priority", type=float, default=1.0)
+    parser.add_argument("--request-id", help="idempotency key (retries are safe)")
+    kinds = parser.add_subparsers(dest="kind", required=True)
+    inspect = kinds.add_parser("inspect", help="inspect waypoints")
+    inspect.add_argument("waypoints", nargs="+", type=_point, metavar="X,Y,Z[,SERVICE_S]")
+    monitor = kinds.add_parser("monitor", help="monitor a worker")
+    monitor.add_argument("worker")
+    monitor.add_argument("--uavs", type=int, default=1)
+    monitor.add_argument("--duration", type=float, required=True, help="seconds")
+    monitor.add_argument("--standoff", type=float, default=5.0, help="metres")
+    deliver = kinds.add_parser("deliver", help="deliver a tool to a worker")
+    deliver.add_argument("tool")
+    deliver.add_argument("--from", dest="station", required=True, help="tool station id")
+    deliver.add_argument("--to", dest="worker", required=True, help="worker id")
+    args = parser.parse_args(argv)
+    body: dict[str, Any] = {"type": args.kind, "priority": args.priority}
+    match args.kind:
+        case "inspect":
+            body["waypoints"] = args.waypoints
+        case "monitor":
+            body |= {
+                "worker_id": args.worker,
+                "uavs": args.uavs,
+                "duration_s": args.duration,
+                "standoff_m": args.standoff,
+            }
+        case "deliver":
+            body |= {"tool": args.tool, "tool_station_id": args.station, "worker_id": args.worker}
+    if args.request_id:
+        body["request_id"] = args.request_id
+    return _run(
+        args, lambda g: g.call("POST", "/v1/actions", json=body), lambda r: actions_table([r])
+    )
+
+
+def gesture_main(argv: list[str]) -> int:
+    """``linecrew gesture NAME TARGET``"""
+    parser = _parser("gesture", "submit a crew gesture (e.g. bring-wrench W1)")
+    parser.add_argument("gesture")
+    parser.add_argument("target", help="tower, line or worker id")
+    args = parser.parse_args(argv)
+    body = {"gesture": args.gesture, "target": args.target}
+    return _run(
+        args, lambda g: g.call("POST", "/v1/gestures", json=body), lambda r: actions_table([r])
+    )
+
+
+def actions_main(argv: list[str]) -> int:
+    """``linecrew actions [--state S,...]``"""
+    parser = _parser("actions", "list actions")
+    parser.add_argument("--state", help="comma-separated states")
+    args = parser.parse_args(argv)
+    params = {"state": args.state} if args.state else {}
+    return _run(args, lambda g: g.call("GET", "/v1/actions", params=params), actions_table)
+
+
+def cancel_main(argv: list[str]) -> int:
+    """``linecrew cancel ACTION_ID``"""
+    parser = _parser("cancel", "cancel an action")
+    parser.add_argument("action_id")
+    args = parser.parse_args(argv)
+    return _run(
+        args,
+        lambda g: g.call("DELETE", f"/v1/actions/{args.action_id}"),
+        lambda r: actions_table([r]),
+    )
+
+
+def status_main(argv: list[str]) -> int:
+    """``linecrew status``: the fleet."""
+    args = _parser("status", "fleet table").parse_args(argv)
+    return _run(args, lambda g: g.call("GET", "/v1/fleet"), fleet_table)
+
+
+def plan_main(argv: list[str]) -> int:
+    """``linecrew plan``: the live plan as a timeline. With a problem file
+    (``linecrew plan PROBLEM ...``) it runs the offline planner instead."""
+    if (argv and not argv[0].startswith("-")) or "--validate" in argv:
+        from ground_station.planner.cli import plan_main as offline
+
+        return offline(argv)
+    parser = _parser("plan", "live plan of every UAV (give a PROBLEM file to plan offline)")
+    parser.add_argument("--speedup", type=float, default=1.0, help="the run's mission speed-up")
+    args = parser.parse_args(argv)
+    now = time.time() * args.speedup
+    return _run(args, lambda g: g.call("GET", "/v1/plan"), lambda p: plan_timeline(p, now))
+
+
+def events_main(argv: list[str]) -> int:
+    """``linecrew events [--after SEQ]``: follow the event stream."""
+    parser = _parser("events", "follow ground-station events (Ctrl-C to stop)")
+    parser.add_argument("--after", type=int, help="replay events after this sequence number")
+    args = parser.parse_args(argv)
+    url, token = session(args.url, args.token)
+    try:
+        for event in Gateway(url, token).events(args.after):
+            if args.json:
+                print(json.dumps(event), flush=True)
+            else:
+                who = event.get("uav_id") or event.get("action_id") or ""
+                print(
+                    f"{event['seq']:>6} {event['kind']:<16} {who:<16} {event['detail']}", flush=True
+                )
+    except GatewayError as exc:
+        print(f"linecrew: {exc}", file=sys.stderr)
+        return 1
+    except KeyboardInterrupt:
+        pass
+    return 0
+
+
+def fault_main(argv: list[str]) -> int:
+    """``linecrew fault KIND TARGET [VALUES]`` through the gateway (simulation only)."""
+    parser = _parser("fault", "inject a simulator fault through the gateway")
+    add_fault_arguments(parser)
+    args = parser.parse_args(argv)
+    try:
+        fault = msgspec.to_builtins(fault_from_args(args))
+    except ValueError as exc:
+        parser.error(str(exc))
+    return _run(
+        args,
+        lambda g: g.call("POST", "/v1/sim/faults", json=fault),
+        lambda r: f"{r['target']}: {r['detail']}",
+    )

@@ -1,0 +1,90 @@
+"""HTTP access to a linecrew gateway for the operator CLI.
+
+Where to find it: ``--url`` / ``--token``, else ``LINECREW_URL`` /
+``LINECREW_TOKEN``, else the session file that ``linecrew up`` writes
+(``.linecrew/session.json`` in the current directory).
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import pathlib
+from collections.abc import Iterator
+from typing import Any
+
+import httpx
+
+from proto.errors import LinecrewError
+
+SESSION_FILE = pathlib.Path(".linecrew") / "session.json"
+DEFAULT_URL = "http://127.0.0.1:8080"
+
+
+class GatewayError(LinecrewError):
+    """The gateway refused a request or could not be reached; the message
+    says which, and why."""
+
+    code = "gateway_error"
+
+
+def session(url: str | None, token: str | None) -> tuple[str, str]:
+    """The gateway URL and token to use."""
+    saved: dict[str, str] = {}
+    if SESSION_FILE.is_file():
+        saved = json.loads(SESSION_FILE.read_text())
+    url = url or os.environ.get("LINECREW_URL") or saved.get("url") or DEFAULT_URL
+    token = token or os.environ.get("LINECREW_TOKEN") or saved.get("token") or ""
+    return url, token
+
+
+def write_session(url: str, token: str) -> pathlib.Path:
+    """Remember a running gateway for later CLI calls (``linecrew up`` does this)."""
+    SESSION_FILE.parent.mkdir(exist_ok=True)
+    SESSION_FILE.write_text(json.dumps({"url": url, "token": token}))
+    SESSION_FILE.chmod(0o600)
+    return SESSION_FILE
+
+
+class Gateway:
+    """A thin client: JSON in, JSON out, errors as :class:`GatewayError`."""
+
+    def __init__(self, url: str, token: str, timeout_s: float = 10.0) -> None:
+        self.url = url
+        self._http = httpx.Client(
+            base_url=url, timeout=timeout_s, headers={"Authorization": f"Bearer {token}"}
+        )
+
+    def call(self, method: str, path: str, **kwargs: Any) -> Any:
+        """Send a request; the decoded JSON answer."""
+        try:
+            response = self._http.request(method, path, **kwargs)
+        except httpx.HTTPError as exc:
+            raise GatewayError(f"cannot reach the gateway at {self.url}: {exc}") from exc
+        if response.status_code >= 400:
+            raise GatewayError(_explain(response))
+        return response.json()
+
+    def events(self, after_seq: int | None = None) -> Iterator[dict[str, Any]]:
+        """Follow ``/v1/events`` (Server-Sent Events) until interrupted."""
+        params = {"after_seq": after_seq} if after_seq is not None else {}
+        try:
+            with self._http.stream("GET", "/v1/events", params=params, timeout=None) as stream:
+                if stream.status_code >= 400:
+                    stream.read()
+                    raise GatewayError(_explain(stream))
+                for line in stream.iter_lines():
+                    if line.startswith("data: "):
+                        yield json.loads(line[6:])
+        except httpx.HTTPError as exc:
+            raise GatewayError(f"event stream from {self.url} failed: {exc}") from exc
+
+
+def _explain(response: httpx.Response) -> str:
+    try:
+        body = response.json()
+    except ValueError:
+        return f"HTTP {response.status_code}: {response.text[:200]}"
+    field = f" (field {body['field']})" if body.get("field") else ""
+    known = f"; known: {', '.join(body['known'])}" if body.get("known") else ""
+    return f"HTTP {response.status_code} {body.get('error')}: {body.get('message')}{field}{known}"

@@ -1,0 +1,96 @@
+"""Terminal views of gateway answers (rich): actions, fleet, plan timeline."""
+
+from __future__ import annotations
+
+from typing import Any
+
+from rich.table import Table
+from rich.text import Text
+
+GLYPH = {
+    "inspect": ("I", "green"),
+    "monitor": ("M", "blue"),
+    "pick": ("P", "magenta"),
+    "deliver": ("D", "red"),
+    "recharge": ("R", "yellow"),
+    "wait": ("w", "bright_black"),
+    "home": ("H", "cyan"),
+}
+
+
+def actions_table(records: list[dict[str, Any]]) -> Table:
+    """One row per action."""
+    table = Table(title="Actions")
+    for column in ("id", "kind", "state", "progress", "priority", "note"):
+        table.add_column(column)
+    for r in records:
+        table.add_row(
+            r["action_id"],
+            r["action"]["type"],
+            r["state"],
+            f"{100 * r['progress']:.0f} %",
+            f"{r['action']['priority']:g}",
+            r.get("reason", ""),
+        )
+    return table
+
+
+def fleet_table(uavs: list[dict[str, Any]]) -> Table:
+    """One row per UAV."""
+    table = Table(title="Fleet")
+    for column in ("uav", "state", "battery", "position (m)", "task", "epoch"):
+        table.add_column(column)
+    for u in uavs:
+        tel, status = u.get("telemetry") or {}, u.get("status") or {}
+        pos = tel.get("position")
+        table.add_row(
+            u["uav_id"],
+            u["state"],
+            f"{100 * tel['battery_fraction']:.0f} %" if tel else "-",
+            f"{pos['x_m']:.0f}, {pos['y_m']:.0f}, {pos['z_m']:.0f}" if pos else "-",
+            status.get("task_id") or "-",
+            str(status.get("epoch", "-")),
+        )
+    return table
+
+
+Segment = tuple[float, float, str]
+"""(start_s, end_s, task kind) on the mission clock."""
+
+
+def timeline(
+    rows: list[tuple[str, str, list[Segment]]],
+    start_s: float,
+    end_s: float,
+    title: str,
+    width: int = 64,
+) -> Table:
+    """One row per ``(label, note, segments)`` on a shared axis from ``start_s`` to ``end_s``."""
+    span = max(end_s - start_s, 1.0)
+    table = Table(title=f"{title}: {span:.0f} s, one column = {span / width:.1f} s")
+    table.add_column("UAV", no_wrap=True)
+    table.add_column("", justify="right")
+    table.add_column("timeline", no_wrap=True)
+    for label, note, segments in rows:
+        cells = [(" ", "")] * width
+        for seg_start, seg_end, kind in segments:
+            a = max(0, int((seg_start - start_s) / span * (width - 1)))
+            b = max(a + 1, int((seg_end - start_s) / span * (width - 1)))
+            for i in range(a, min(b, width)):
+                cells[i] = GLYPH.get(kind, ("?", ""))
+        line = Text()
+        for char, style in cells:
+            line.append(char, style=style)
+        table.add_row(label, note, line)
+    table.caption = "  ".join(f"{g} {k}" for k, (g, _) in GLYPH.items())
+    return table
+
+
+def plan_timeline(plans: list[dict[str, Any]], now_s: float) -> Table:
+    """The planned tasks of every UAV from ``now_s`` on."""
+    rows = [
+        (p["uav_id"], f"e{p['epoch']}", [(t["start_s"], t["end_s"], t["type"]) for t in p["tasks"]])
+        for p in plans
+    ]
+    end = max((t["end_s"] for p in plans for t in p["tasks"]), default=now_s + 1.0)
+    return timeline(rows, now_s, end, "Plan")

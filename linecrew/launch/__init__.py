@@ -1,0 +1,1 @@
+"""Running a whole linecrew deployment locally: ``linecrew up`` and ``linecrew demo``."""

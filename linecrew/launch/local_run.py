@@ -1,0 +1,167 @@
+"""Everything of a linecrew deployment on this machine, as child processes:
+router, ground station, gateway, simulator and one agent per UAV, on
+loopback with free ports, started in dependency order and checked healthy.
+Used by ``linecrew up`` and ``linecrew demo``."""
+
+from __future__ import annotations
+
+import dataclasses
+import datetime
+import logging
+import pathlib
+
+import httpx
+import msgspec
+
+from linecrew.bus import Bus, BusConfig
+from linecrew.bus.router_process import free_port, port_open
+from linecrew.client.gateway import write_session
+from linecrew.launch.ports import free_udp_block
+from linecrew.launch.supervisor import Supervisor
+from proto.keys import KeySpace, Role
+from proto.scenario import Scenario
+
+log = logging.getLogger(__name__)
+
+
+@dataclasses.dataclass(frozen=True, kw_only=True)
+class RunOptions:
+    """What to start and how."""
+
+    speedup: float = 1.0  # mission seconds per wall second, for every process
+    gateway_port: int = 0  # 0: a free port
+    run_dir: pathlib.Path | None = None  # default runs/<UTC time>
+    lease_ms: int = 500  # zenoh lease of every process
+    start_timeout_s: float = 60.0  # per process
+
+
+class LocalRun:
+    """A context manager: ``with LocalRun(scenario, options) as run:``."""
+
+    def __init__(self, scenario: Scenario, options: RunOptions) -> None:
+        self.scenario = scenario
+        self.options = options
+        stamp = datetime.datetime.now(datetime.UTC).strftime("%Y%m%dT%H%M%SZ")
+        self.run_dir = options.run_dir or pathlib.Path("runs") / stamp
+        self.keys = KeySpace(scenario.site.id)
+        self.supervisor = Supervisor(self.run_dir)
+        self.endpoint = ""
+        self.url = ""
+        self.token = ""
+        self.bus: Bus | None = None
+
+    def __enter__(self) -> LocalRun:
+        try:
+            self._start()
+        except BaseException:
+            self.close()
+            raise
+        return self
+
+    def __exit__(self, *_exc: object) -> None:
+        self.close()
+
+    def close(self) -> None:
+        """Stop every process (newest first) and leave the bus."""
+        if self.bus is not None:
+            self.bus.close()
+            self.bus = None
+        self.supervisor.stop_all()
+
+    def _start(self) -> None:
+        opts, keys = self.options, self.keys
+        self.run_dir.mkdir(parents=True, exist_ok=True)
+        scenario_file = self.run_dir / "scenario.json"
+        scenario_file.write_bytes(msgspec.json.encode(self.scenario))
+        router_port = free_port()
+        self.endpoint = f"tcp/127.0.0.1:{router_port}"
+        common = [
+            "--connect",
+            self.endpoint,
+            "--lease-ms",
+            str(opts.lease_ms),
+            "--speedup",
+            str(opts.speedup),
+        ]
+        sup, wait = self.supervisor, opts.start_timeout_s
+
+        router = sup.start(
+            "router",
+            "ground_station.router",
+            "--listen",
+            self.endpoint,
+            "--site",
+            keys.site,
+            "--lease-ms",
+            str(opts.lease_ms),
+        )
+        sup.wait_ready(router, lambda: port_open(router_port), wait)
+        self.bus = Bus.open(BusConfig(connect=(self.endpoint,), lease_ms=opts.lease_ms))
+
+        gs = sup.start(
+            "ground-station",
+            "ground_station",
+            *common,
+            "--scenario",
+            str(scenario_file),
+            "--db",
+            str(self.run_dir / "gs.db"),
+        )
+        sup.wait_ready(gs, lambda: self._alive(Role.GROUND_STATION, "gs"), wait)
+
+        uavs = [u.id for u in self.scenario.fleet.uavs]
+        base_port = free_udp_block(len(uavs))
+        sim = sup.start(
+            "sim",
+            "sim_fleet",
+            *common,
+            "--scenario",
+            str(scenario_file),
+            "--base-port",
+            str(base_port),
+        )
+        sup.wait_ready(sim, lambda: self._alive(Role.SIM, "sim"), wait)
+
+        gateway_port = opts.gateway_port or free_port()
+        self.url = f"http://127.0.0.1:{gateway_port}"
+        token_file = self.run_dir / "token"
+        gateway = sup.start(
+            "gateway",
+            "ground_station.gateway",
+            *common,
+            "--scenario",
+            str(scenario_file),
+            "--port",
+            str(gateway_port),
+            "--token-file",
+            str(token_file),
+        )
+        sup.wait_ready(gateway, self._gateway_healthy, wait)
+        self.token = token_file.read_text().strip()
+        write_session(self.url, self.token)
+
+        for index, uav_id in enumerate(uavs):
+            agent = sup.start(
+                f"agent-{uav_id}",
+                "onboard_agent",
+                *common,
+                "--uav",
+                uav_id,
+                "--scenario",
+                str(scenario_file),
+                "--autopilot",
+                f"udpout:127.0.0.1:{base_port + index}",
+            )
+            sup.wait_ready(agent, lambda u=uav_id: self._alive(Role.AGENT, u), wait)
+        log.info("all processes healthy", extra={"run_dir": str(self.run_dir)})
+
+    def _alive(self, role: Role, ident: str) -> bool:
+        assert self.bus is not None
+        key = self.keys.alive(role, ident)
+        return key in self.bus.alive(key, timeout_s=0.5)
+
+    def _gateway_healthy(self) -> bool:
+        try:
+            return httpx.get(f"{self.url}/healthz", timeout=1.0).status_code == 200
+        except httpx.HTTPError:
+            return False

@@ -1,0 +1,111 @@
+"""Child processes of ``linecrew up``: started in their own sessions with a
+log file each, checked for health, stopped in reverse order (SIGTERM, then
+SIGKILL), and told to die with their parent (Linux ``PR_SET_PDEATHSIG``) so
+nothing is orphaned even if the supervisor is killed."""
+
+from __future__ import annotations
+
+import contextlib
+import ctypes
+import dataclasses
+import logging
+import os
+import pathlib
+import signal
+import subprocess
+import sys
+import time
+from collections.abc import Callable
+
+log = logging.getLogger(__name__)
+
+_PR_SET_PDEATHSIG = 1
+
+
+def _die_with_parent() -> None:  # runs in the child between fork and exec
+    with contextlib.suppress(OSError, AttributeError):
+        ctypes.CDLL("libc.so.6", use_errno=True).prctl(_PR_SET_PDEATHSIG, signal.SIGTERM)
+
+
+class StartError(RuntimeError):
+    """A child exited or never became healthy; the message names it and its log."""
+
+
+@dataclasses.dataclass
+class Child:
+    """One supervised process."""
+
+    name: str
+    popen: subprocess.Popen[bytes]
+    log_path: pathlib.Path
+
+    def alive(self) -> bool:
+        """Still running."""
+        return self.popen.poll() is None
+
+    def tail(self, lines: int = 15) -> str:
+        """The end of its log."""
+        text = self.log_path.read_text(errors="replace") if self.log_path.exists() else ""
+        return "\n".join(text.splitlines()[-lines:])
+
+
+class Supervisor:
+    """Starts, watches and stops the processes of one run."""
+
+    def __init__(self, run_dir: pathlib.Path) -> None:
+        self.run_dir = run_dir
+        self.children: list[Child] = []
+
+    def start(self, name: str, module: str, *args: str) -> Child:
+        """Start ``python -m module args...`` logging to ``run_dir/name.log``."""
+        log_path = self.run_dir / f"{name}.log"
+        env = dict(os.environ, PYTHONUNBUFFERED="1")
+        with open(log_path, "wb") as log_file:
+            popen = subprocess.Popen(
+                [sys.executable, "-m", module, *args],
+                stdout=log_file,
+                stderr=subprocess.STDOUT,
+                stdin=subprocess.DEVNULL,
+                env=env,
+                start_new_session=True,
+                preexec_fn=_die_with_parent,
+            )
+        child = Child(name, popen, log_path)
+        self.children.append(child)
+        return child
+
+    def wait_ready(self, child: Child, ready: Callable[[], object], timeout_s: float) -> None:
+        """Wait until ``ready()``; raise :class:`StartError` if the child dies or is late."""
+        deadline = time.monotonic() + timeout_s
+        while not ready():
+            if not child.alive():
+                raise StartError(
+                    f"{child.name} exited with code {child.popen.returncode}; "
+                    f"its log ({child.log_path}):\n{child.tail()}"
+                )
+            if time.monotonic() > deadline:
+                raise StartError(
+                    f"{child.name} not healthy after {timeout_s:.0f} s; "
+                    f"its log ({child.log_path}):\n{child.tail()}"
+                )
+            time.sleep(0.05)
+
+    def dead(self) -> list[Child]:
+        """Children that have exited."""
+        return [c for c in self.children if not c.alive()]
+
+    def stop_all(self, timeout_s: float = 10.0) -> None:
+        """SIGTERM every child (newest first), then SIGKILL what is left."""
+        for child in reversed(self.children):
+            if child.alive():
+                with contextlib.suppress(ProcessLookupError):
+                    os.killpg(child.popen.pid, signal.SIGTERM)
+        deadline = time.monotonic() + timeout_s
+        for child in reversed(self.children):
+            try:
+                child.popen.wait(max(0.1, deadline - time.monotonic()))
+            except subprocess.TimeoutExpired:
+                log.warning("%s ignored SIGTERM; killing it", child.name)
+                with contextlib.suppress(ProcessLookupError):
+                    os.killpg(child.popen.pid, signal.SIGKILL)
+                child.popen.wait()

@@ -1,0 +1,323 @@
+"""The MAVLink link to one autopilot (ArduCopter GUIDED conventions).
+
+This is the only pymavlink importer of the agent. A daemon thread blocks in
+``recv_match`` and hands every message to the asyncio loop with
+``loop.call_soon_threadsafe``; all state lives on the loop thread. Commands
+are asyncio tasks: each sends a COMMAND_LONG and waits for its COMMAND_ACK,
+resending up to ``command_retries`` times; a refusal becomes
+:class:`CommandDenied` carrying the autopilot's last STATUSTEXT as the reason.
+Position targets (SET_POSITION_TARGET_GLOBAL_INT) have no ACK in MAVLink, so
+callers repeat them. A silent autopilot (no HEARTBEAT for
+``heartbeat_timeout_s``) shows as ``state.link_ok == False``.
+"""
+
+from __future__ import annotations
+
+import asyncio
+import dataclasses
+import logging
+import os
+import threading
+import time
+from collections.abc import Callable
+from typing import Any
+
+os.environ["MAVLINK20"] = "1"  # before importing mavutil: speak MAVLink 2
+from pymavlink import mavutil
+
+from onboard_agent.autopilot.errors import CommandDenied, CommandTimeout, LinkLost
+from onboard_agent.autopilot.protocol import VehicleState
+from onboard_agent.config import AgentConfig
+from proto.geo import GeoPoint, LocalFrame, Point, Vector
+from proto.telemetry import FlightState
+
+log = logging.getLogger(__name__)
+mav = mavutil.mavlink
+
+# ArduCopter custom_mode numbers
+COPTER_MODES = {
+    0: "STABILIZE",
+    2: "ALT_HOLD",
+    3: "AUTO",
+    4: "GUIDED",
+    5: "LOITER",
+    6: "RTL",
+    9: "LAND",
+}
+MODE_NUMBERS = {name: number for number, name in COPTER_MODES.items()}
+LANDED_STATES = {
+    mav.MAV_LANDED_STATE_ON_GROUND: FlightState.LANDED,
+    mav.MAV_LANDED_STATE_IN_AIR: FlightState.FLYING,
+    mav.MAV_LANDED_STATE_TAKEOFF: FlightState.TAKING_OFF,
+    mav.MAV_LANDED_STATE_LANDING: FlightState.LANDING,
+}
+POSITION_ONLY = 0b110111111000  # SET_POSITION_TARGET type_mask: use x, y, z only
+STREAMS_HZ = {"GLOBAL_POSITION_INT": 5.0, "BATTERY_STATUS": 1.0, "EXTENDED_SYS_STATE": 1.0}
+TEXT_FRESH_S = 2.0  # a STATUSTEXT this recent explains a refused command
+
+
+class MavlinkLink:
+    """One autopilot over any pymavlink connection string (``udpout:``,
+    ``udpin:``, ``tcp:``, serial). Use :meth:`start` then ``await run()``."""
+
+    def __init__(
+        self,
+        url: str,
+        frame: LocalFrame,
+        config: AgentConfig,
+        *,
+        clock: Callable[[], float] = time.monotonic,
+        source_system: int = 255,
+        source_component: int = 190,
+    ) -> None:
+        self.url = url
+        self.frame = frame
+        self.config = config
+        self.clock = clock
+        self._source = (source_system, source_component)
+        self._state = VehicleState()
+        self._target: tuple[int, int] | None = None
+        self._found: asyncio.Event | None = None
+        self._acks: dict[int, asyncio.Future[Any]] = {}
+        self._last_heartbeat = -1e9
+        self._last_text = ("", -1e9)
+        self._conn: Any = None
+        self._loop: asyncio.AbstractEventLoop | None = None
+        self._thread: threading.Thread | None = None
+        self._closing = threading.Event()
+        self._battery_status_seen = False
+        self._tasks: set[asyncio.Task[Any]] = set()
+
+    # -- lifecycle ---------------------------------------------------------------
+
+    def start(self) -> None:
+        """Open the connection and start the receive thread (on the loop)."""
+        self._loop = asyncio.get_running_loop()
+        self._found = asyncio.Event()
+        system, component = self._source
+        self._conn = mavutil.mavlink_connection(
+            self.url, source_system=system, source_component=component, autoreconnect=True
+        )
+        self._thread = threading.Thread(target=self._receive, name="mavlink-rx", daemon=True)
+        self._thread.start()
+        self._send_heartbeat()  # a udpout peer learns our address from what we send
+
+    async def run(self) -> None:
+        """Send our heartbeat at 1 Hz and watch the autopilot's, until closed."""
+        while not self._closing.is_set():
+            self._send_heartbeat()
+            silent = self.clock() - self._last_heartbeat > self.config.heartbeat_timeout_s
+            if silent and self._state.link_ok:
+                log.warning("autopilot heartbeat lost", extra={"url": self.url})
+                self._state = dataclasses.replace(self._state, link_ok=False)
+            await asyncio.sleep(1.0)
+
+    def close(self) -> None:
+        """Stop the receive thread and close the connection; idempotent."""
+        self._closing.set()
+        for task in list(self._tasks):
+            task.cancel()
+        if self._thread is not None:
+            self._thread.join(2.0)
+        if self._conn is not None:
+            self._conn.close()
+            self._conn = None
+
+    @property
+    def state(self) -> VehicleState:
+        return self._state
+
+    # -- commands (call on the loop thread) ----------------------------------------
+
+    def set_mode(self, mode: str) -> asyncio.Task[None]:
+        number = MODE_NUMBERS[mode]
+        return self._spawn(self._command(f"mode {mode}", mav.MAV_CMD_DO_SET_MODE, 1, number))
+
+    def arm(self) -> asyncio.Task[None]:
+        return self._spawn(self._command("arm", mav.MAV_CMD_COMPONENT_ARM_DISARM, 1))
+
+    def disarm(self) -> asyncio.Task[None]:
+        return self._spawn(self._command("disarm", mav.MAV_CMD_COMPONENT_ARM_DISARM, 0))
+
+    def takeoff(self, alt_m: float) -> asyncio.Task[None]:
+        return self._spawn(
+            self._command("takeoff", mav.MAV_CMD_NAV_TAKEOFF, 0, 0, 0, 0, 0, 0, alt_m)
+        )
+
+    def land(self) -> asyncio.Task[None]:
+        return self._spawn(self._command("land", mav.MAV_CMD_NAV_LAND))
+
+    def grab(self) -> asyncio.Task[None]:
+        return self._spawn(self._command("gripper grab", mav.MAV_CMD_DO_GRIPPER, 1, 1))
+
+    def release(self) -> asyncio.Task[None]:
+        return self._spawn(self._command("gripper release", mav.MAV_CMD_DO_GRIPPER, 1, 0))
+
+    def change_speed(self, speed_mps: float) -> asyncio.Task[None]:
+        return self._spawn(self._command("speed", mav.MAV_CMD_DO_CHANGE_SPEED, 1, speed_mps, -1))
+
+    def goto(self, target: Point) -> asyncio.Task[None]:
+        """Send a position target (relative altitude = local z); no ACK exists."""
+        return self._spawn(self._goto(target))
+
+    async def _goto(self, target: Point) -> None:
+        system, component = await self._wait_target()
+        geo = self.frame.to_geodetic(target)
+        self._conn.mav.set_position_target_global_int_send(
+            0,
+            system,
+            component,
+            mav.MAV_FRAME_GLOBAL_RELATIVE_ALT_INT,
+            POSITION_ONLY,
+            round(geo.lat_deg * 1e7),
+            round(geo.lon_deg * 1e7),
+            target.z_m,
+            0,
+            0,
+            0,
+            0,
+            0,
+            0,
+            0,
+            0,
+        )
+
+    async def _command(self, name: str, command: int, *params: float) -> None:
+        system, component = await self._wait_target()
+        p = [float(x) for x in params] + [0.0] * (7 - len(params))
+        assert self._loop is not None
+        for attempt in range(self.config.command_retries + 1):
+            future: asyncio.Future[Any] = self._loop.create_future()
+            self._acks[command] = future
+            self._conn.mav.command_long_send(system, component, command, attempt, *p)
+            try:
+                ack = await asyncio.wait_for(future, self.config.command_ack_timeout_s)
+            except TimeoutError:
+                log.info("%s: no ACK (attempt %d)", name, attempt + 1)
+                continue
+            finally:
+                if self._acks.get(command) is future:
+                    del self._acks[command]
+            if ack.result == mav.MAV_RESULT_ACCEPTED:
+                return
+            result = mav.enums["MAV_RESULT"][ack.result].name.removeprefix("MAV_RESULT_")
+            raise CommandDenied(name, result, self._recent_text())
+        tries = self.config.command_retries + 1
+        raise CommandTimeout(f"{name}: no COMMAND_ACK after {tries} tries")
+
+    async def _wait_target(self) -> tuple[int, int]:
+        assert self._found is not None
+        if self._target is None:
+            try:
+                await asyncio.wait_for(self._found.wait(), self.config.heartbeat_timeout_s)
+            except TimeoutError:
+                raise LinkLost(f"no autopilot heartbeat on {self.url}") from None
+        assert self._target is not None
+        return self._target
+
+    def _spawn(self, coro: Any) -> asyncio.Task[Any]:
+        task = asyncio.get_running_loop().create_task(coro)
+        self._tasks.add(task)
+        task.add_done_callback(self._tasks.discard)
+        return task
+
+    def _recent_text(self) -> str:
+        text, stamp = self._last_text
+        return text if self.clock() - stamp <= TEXT_FRESH_S else ""
+
+    # -- receiving -------------------------------------------------------------------
+
+    def _receive(self) -> None:
+        while not self._closing.is_set():
+            try:
+                msg = self._conn.recv_match(blocking=True, timeout=0.2)
+            except Exception as exc:  # a bad packet or a closed socket must not kill the thread
+                if self._closing.is_set():
+                    return
+                log.debug("mavlink receive failed: %s", exc)
+                continue
+            if msg is None or msg.get_type() == "BAD_DATA":
+                continue
+            try:
+                assert self._loop is not None
+                self._loop.call_soon_threadsafe(self._on_message, msg)
+            except RuntimeError:  # the loop is closed: we are shutting down
+                return
+
+    def _on_message(self, msg: Any) -> None:
+        kind = msg.get_type()
+        if kind == "HEARTBEAT":
+            self._on_heartbeat(msg)
+            return
+        if self._target is None or msg.get_srcSystem() != self._target[0]:
+            return
+        s = self._state
+        match kind:
+            case "GLOBAL_POSITION_INT":
+                geo = GeoPoint(lat_deg=msg.lat / 1e7, lon_deg=msg.lon / 1e7, alt_m=msg.alt / 1000)
+                local = self.frame.to_local(geo)
+                position = Point(x_m=local.x_m, y_m=local.y_m, z_m=msg.relative_alt / 1000)
+                velocity = Vector(
+                    east_mps=msg.vy / 100, north_mps=msg.vx / 100, up_mps=-msg.vz / 100
+                )
+                heading = msg.hdg / 100 if msg.hdg != 65535 else s.heading_deg
+                self._state = dataclasses.replace(
+                    s, position=position, geo=geo, velocity=velocity, heading_deg=heading
+                )
+                self._state = dataclasses.replace(self._state, known=True)
+            case "EXTENDED_SYS_STATE":
+                state = LANDED_STATES.get(msg.landed_state, FlightState.UNKNOWN)
+                self._state = dataclasses.replace(s, flight_state=state)
+            case "BATTERY_STATUS" if msg.battery_remaining >= 0:
+                self._battery_status_seen = True
+                charging = msg.charge_state == mav.MAV_BATTERY_CHARGE_STATE_CHARGING
+                fraction = msg.battery_remaining / 100
+                self._state = dataclasses.replace(s, battery_fraction=fraction, charging=charging)
+            case "SYS_STATUS" if msg.battery_remaining >= 0 and not self._battery_status_seen:
+                self._state = dataclasses.replace(s, battery_fraction=msg.battery_remaining / 100)
+            case "COMMAND_ACK":
+                future = self._acks.get(msg.command)
+                final = msg.result != mav.MAV_RESULT_IN_PROGRESS
+                if future is not None and not future.done() and final:
+                    future.set_result(msg)
+            case "STATUSTEXT":
+                self._last_text = (msg.text, self.clock())
+                log.info("autopilot: %s", msg.text)
+
+    def _on_heartbeat(self, msg: Any) -> None:
+        if msg.type == mav.MAV_TYPE_GCS or msg.autopilot == mav.MAV_AUTOPILOT_INVALID:
+            return
+        if self._target is None:
+            self._target = (msg.get_srcSystem(), msg.get_srcComponent())
+            assert self._found is not None
+            self._found.set()
+            log.info("autopilot found: system %d on %s", self._target[0], self.url)
+            self._request_streams()
+        elif msg.get_srcSystem() != self._target[0]:
+            return
+        self._last_heartbeat = self.clock()
+        armed = bool(msg.base_mode & mav.MAV_MODE_FLAG_SAFETY_ARMED)
+        mode = COPTER_MODES.get(msg.custom_mode, str(msg.custom_mode))
+        if not self._state.link_ok:
+            log.info("autopilot heartbeat received")
+        self._state = dataclasses.replace(self._state, armed=armed, mode=mode, link_ok=True)
+
+    def _request_streams(self) -> None:
+        self._spawn(self._streams())
+
+    async def _streams(self) -> None:
+        """Ask for the telemetry we use (one at a time: the ACKs carry no
+        message id); a refusal only means the autopilot streams by default."""
+        for name, hz in STREAMS_HZ.items():
+            msg_id = getattr(mav, f"MAVLINK_MSG_ID_{name}")
+            interval_us = 1e6 / hz
+            try:
+                await self._command(
+                    f"stream {name}", mav.MAV_CMD_SET_MESSAGE_INTERVAL, msg_id, interval_us
+                )
+            except (CommandDenied, CommandTimeout) as exc:
+                log.debug("stream request refused: %s", exc)
+
+    def _send_heartbeat(self) -> None:
+        if self._conn is not None:
+            self._conn.mav.heartbeat_send(mav.MAV_TYPE_GCS, mav.MAV_AUTOPILOT_INVALID, 0, 0, 0)

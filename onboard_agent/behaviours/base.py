@@ -1,0 +1,77 @@
+"""What every agent behaviour shares: the context, and a slot for one
+autopilot command in flight.
+
+``update()`` never blocks: a behaviour issues a command (which returns a
+:class:`~onboard_agent.autopilot.protocol.Pending`) and checks it on the
+following ticks.
+"""
+
+from __future__ import annotations
+
+import py_trees
+
+from onboard_agent.autopilot.protocol import Pending
+from onboard_agent.context import Context
+
+Status = py_trees.common.Status
+
+
+class AgentBehaviour(py_trees.behaviour.Behaviour):
+    """A behaviour with the agent's :class:`Context`. ``kind`` is the node
+    category in the BehaviorTree.CPP export (Action or Condition)."""
+
+    kind = "Action"
+
+    def __init__(self, name: str, ctx: Context) -> None:
+        super().__init__(name)
+        self.ctx = ctx
+
+
+class Condition(AgentBehaviour):
+    """A check: SUCCESS if ``holds()``, else FAILURE; never RUNNING."""
+
+    kind = "Condition"
+
+    def holds(self) -> bool:
+        raise NotImplementedError
+
+    def update(self) -> Status:
+        result = self.holds()
+        self.feedback_message = "yes" if result else "no"
+        return Status.SUCCESS if result else Status.FAILURE
+
+
+class CommandSlot:
+    """One autopilot command in flight, and what it was."""
+
+    def __init__(self) -> None:
+        self._pending: Pending | None = None
+        self.label = ""
+        self.error = ""
+
+    def issue(self, label: str, pending: Pending) -> None:
+        self.label, self._pending, self.error = label, pending, ""
+
+    def check(self) -> Status:
+        """RUNNING while in flight; SUCCESS when acknowledged (or when none
+        was issued); FAILURE with ``error`` when refused or timed out."""
+        pending = self._pending
+        if pending is None:
+            return Status.SUCCESS
+        if not pending.done():
+            return Status.RUNNING
+        self._pending = None
+        if pending.cancelled():
+            self.error, self.label = f"{self.label}: cancelled", ""
+            return Status.FAILURE
+        exc = pending.exception()
+        if exc is not None:
+            self.error, self.label = str(exc), ""
+            return Status.FAILURE
+        return Status.SUCCESS
+
+    def cancel(self) -> None:
+        if self._pending is not None and not self._pending.done():
+            self._pending.cancel()
+        self._pending = None
+        self.label = ""

@@ -1,0 +1,86 @@
+"""Energy judgements: is there enough to do the next step and still reach a
+station with the reserve, and is there even enough to reach one now?
+
+"The next step" is the part of the head task up to its next checkpoint: the
+next inspection waypoint with its service time, the next
+``MONITOR_LOOKAHEAD_S`` of monitoring (a long watch is not one step: the UAV
+keeps its slot while it can and leaves for a station when it must, and the
+ground station hands the slot over), the leg to the tool station or the
+worker, the leg to the station of a recharge / go-home task, or hovering
+until a wait ends when airborne.
+"""
+
+from __future__ import annotations
+
+from onboard_agent import targets
+from onboard_agent.context import Context
+from proto.geo import Point
+from proto.plan import (
+    DeliverTask,
+    GoHomeTask,
+    InspectTask,
+    MonitorTask,
+    PickTask,
+    RechargeTask,
+    WaitTask,
+)
+
+MONITOR_LOOKAHEAD_S = 30.0
+"""Monitoring seconds that must fit in the battery before (and while) watching."""
+
+
+def available_wh(ctx: Context) -> float:
+    """Energy in the pack now, from the autopilot's state of charge."""
+    return ctx.energy.energy_wh(ctx.vehicle.battery_fraction)
+
+
+def to_station_wh(ctx: Context, where: Point) -> float:
+    """Energy to fly from ``where`` to the nearest charging station and land."""
+    station = ctx.surroundings.nearest_station(where)
+    if station is None:
+        return 0.0
+    return ctx.energy.travel_wh(where, station.position)
+
+
+def step_wh(ctx: Context) -> tuple[float, Point]:
+    """Energy of the head task's next step, and where that step ends."""
+    here = ctx.vehicle.position
+    task = ctx.mission.head
+    energy = ctx.energy
+    match task:
+        case InspectTask():
+            wp = ctx.mission.next_waypoint(task)
+            if wp is None:
+                return 0.0, here
+            return energy.travel_wh(here, wp.position) + energy.hover_wh(wp.service_s), wp.position
+        case MonitorTask(duration_s=duration):
+            slot = targets.monitor_slot(ctx) or here
+            left = duration - ctx.mission.monitored_s(task.task_id)
+            look_ahead = min(left, MONITOR_LOOKAHEAD_S)
+            return energy.travel_wh(here, slot) + energy.hover_wh(look_ahead), slot
+        case PickTask(pick_s=service) | DeliverTask(drop_s=service):
+            point = (targets.pick_point if isinstance(task, PickTask) else targets.drop_point)(ctx)
+            point = point or here
+            return energy.travel_wh(here, point) + energy.hover_wh(service), point
+        case RechargeTask() | GoHomeTask():
+            station = ctx.surroundings.station(task.station_id)
+            point = station.position if station is not None else here
+            return energy.travel_wh(here, point), point
+        case WaitTask(until_s=until) if not ctx.vehicle.landed:
+            return energy.hover_wh(until - ctx.wall()), here
+    return 0.0, here
+
+
+def battery_enough(ctx: Context) -> bool:
+    """Enough energy for the next step, then the nearest station, with the reserve."""
+    step, end = step_wh(ctx)
+    needed = step + to_station_wh(ctx, end) + ctx.energy.reserve_wh
+    return available_wh(ctx) >= needed
+
+
+def can_reach_station(ctx: Context) -> bool:
+    """Enough energy to reach the nearest station now and keep the reserve."""
+    if not ctx.vehicle.known or ctx.vehicle.landed:
+        return True  # a landed UAV draws nothing: it recharges instead
+    needed = to_station_wh(ctx, ctx.vehicle.position) + ctx.energy.reserve_wh
+    return available_wh(ctx) >= needed

@@ -1,0 +1,73 @@
+"""The agent's settings: one frozen object built once in ``main()``.
+
+Values come from defaults, then ``LINECREW_AGENT_*`` environment variables
+(the upper-cased field name, e.g. ``LINECREW_AGENT_TICK_HZ=5``), then
+command-line overrides.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import os
+from collections.abc import Mapping
+
+ENV_PREFIX = "LINECREW_AGENT_"
+
+
+@dataclasses.dataclass(frozen=True, kw_only=True)
+class AgentConfig:
+    """Behaviour-tree, emergency and autopilot-link settings of one agent."""
+
+    tick_hz: float = 10.0  # behaviour-tree ticks per second
+    telemetry_hz: float = 5.0  # Telemetry messages per second
+    status_period_s: float = 1.0  # AgentStatus at least this often (and on change)
+    agent_link_timeout_s: float = 3.0  # ground station gone this long -> emergency
+    battery_full_fraction: float = 0.95  # "battery full" at or above this fraction
+    energy_margin: float = 1.15  # factor on predicted energy (wind, estimation errors)
+    near_waypoint_m: float = 1.0  # "near waypoint": 3-D distance
+    near_human_m: float = 2.5  # "near human" when delivering: 3-D distance to the drop point
+    near_slot_m: float = 1.0  # "near human" when monitoring: distance to the slot point
+    near_station_m: float = 0.5  # "near station": horizontal distance
+    near_tool_station_m: float = 1.0  # "near tool station": 3-D distance to the pick point
+    settle_speed_mps: float = 0.3  # below this the vehicle counts as hovering
+    takeoff_alt_m: float = 3.0  # takeoff height above the pad
+    approach_alt_m: float = 3.0  # height above a station before landing
+    pick_height_m: float = 1.0  # height above a tool station to grab / return a tool
+    deliver_height_m: float = 2.0  # height above the worker to release a tool
+    follow_threshold_m: float = 0.5  # re-target the slot when it moved more than this
+    goto_resend_s: float = 1.0  # repeat a position target this often (no ACK exists)
+    task_attempts: int = 3  # a task whose subtree failed this often is reported failed
+    command_ack_timeout_s: float = 1.0  # wait this long for a COMMAND_ACK
+    command_retries: int = 3  # resend an unacknowledged command this many times
+    heartbeat_timeout_s: float = 3.0  # no autopilot HEARTBEAT this long -> link lost
+    plan_query_timeout_s: float = 2.0  # resync query to the ground station
+
+    @classmethod
+    def from_env(cls, env: Mapping[str, str] | None = None, **overrides: object) -> AgentConfig:
+        """Defaults, then ``LINECREW_AGENT_*`` variables, then ``overrides``
+        (``None`` values ignored). Raises ``ValueError`` for a bad value."""
+        env = os.environ if env is None else env
+        values: dict[str, object] = {}
+        for field in dataclasses.fields(cls):
+            raw = env.get(ENV_PREFIX + field.name.upper())
+            if raw is not None:
+                kind = int if field.type in ("int", int) else float
+                try:
+                    values[field.name] = kind(raw)
+                except ValueError as exc:
+                    raise ValueError(f"{ENV_PREFIX}{field.name.upper()}={raw!r}: {exc}") from None
+        values.update({k: v for k, v in overrides.items() if v is not None})
+        config = cls(**values)  # type: ignore[arg-type]
+        config.check()
+        return config
+
+    def check(self) -> None:
+        """Raise ``ValueError`` for settings that cannot work."""
+        if self.tick_hz <= 0 or self.telemetry_hz <= 0:
+            raise ValueError("tick_hz and telemetry_hz must be positive")
+        if not 0.0 < self.battery_full_fraction <= 1.0:
+            raise ValueError("battery_full_fraction must be in (0, 1]")
+        if self.agent_link_timeout_s <= 0 or self.command_ack_timeout_s <= 0:
+            raise ValueError("timeouts must be positive")
+        if self.command_retries < 0:
+            raise ValueError("command_retries must be >= 0")

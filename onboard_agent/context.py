@@ -1,0 +1,41 @@
+"""Everything the behaviours share: one object handed to each of them.
+
+The tree runs on one thread (the asyncio loop, or a test), so plain
+attributes are enough; ``tool`` and ``recharging`` are the agent's beliefs
+that no autopilot message carries.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import time
+from collections.abc import Callable
+
+from onboard_agent.autopilot.protocol import Autopilot, VehicleState
+from onboard_agent.config import AgentConfig
+from onboard_agent.energy import EnergyModel
+from onboard_agent.mission import Mission
+from onboard_agent.surroundings import Surroundings
+
+
+@dataclasses.dataclass(kw_only=True, eq=False)
+class Context:
+    """Shared state of one agent's behaviour tree."""
+
+    uav_id: str
+    config: AgentConfig
+    autopilot: Autopilot
+    mission: Mission
+    surroundings: Surroundings
+    energy: EnergyModel
+    clock: Callable[[], float]  # monotonic mission seconds: task durations (scaled by speed-up)
+    wall: Callable[[], float]  # mission seconds: plan times (WaitTask.until_s)
+    tool: str | None = None  # the tool we believe the gripper holds
+    tool_station_id: str | None = None  # where that tool was picked
+    recharging: bool = False  # a battery-low recharge runs until the battery is full
+    emergency: str = ""  # why the emergency protocol is active ("" when not)
+    link_clock: Callable[[], float] = time.monotonic  # real seconds: link timeouts
+
+    @property
+    def vehicle(self) -> VehicleState:
+        return self.autopilot.state

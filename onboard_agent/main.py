@@ -1,0 +1,86 @@
+"""``python -m onboard_agent`` / ``linecrew agent``: run the agent of one UAV,
+or print its tree (``tree --format xml|ascii``).
+
+    python -m onboard_agent --uav uav-1 --autopilot udpout:127.0.0.1:14560 \\
+        --scenario paper --connect tcp/127.0.0.1:7447
+    python -m onboard_agent tree --format xml > main_tree.xml   # open in Groot2
+"""
+
+from __future__ import annotations
+
+import argparse
+import asyncio
+import logging
+import sys
+
+from linecrew import scenarios
+from linecrew.process import Shutdown, common_parser, start
+from onboard_agent import export
+from onboard_agent.config import AgentConfig
+from onboard_agent.runtime import run_agent
+from proto.errors import LinecrewError
+
+log = logging.getLogger(__name__)
+
+
+def parser() -> argparse.ArgumentParser:
+    """The flags of the agent process."""
+    p = common_parser("linecrew agent", "Onboard agent: fly one UAV's plan.")
+    p.add_argument("--uav", required=True, help="UAV id (as in the scenario's fleet)")
+    p.add_argument(
+        "--autopilot",
+        required=True,
+        help="pymavlink connection string, e.g. udpout:127.0.0.1:14560, tcp:host:5760",
+    )
+    p.add_argument("--scenario", default="paper", help="scenario name or YAML/JSON file")
+    p.add_argument("--tick-hz", type=float, help="behaviour-tree ticks per second (10)")
+    p.add_argument("--link-timeout", type=float, help="agent_link_timeout_s (3.0)")
+    return p
+
+
+def tree_parser() -> argparse.ArgumentParser:
+    p = argparse.ArgumentParser(prog="linecrew agent tree", description="Print the tree.")
+    p.add_argument("--format", choices=export.FORMATS, default="xml")
+    return p
+
+
+def tree_command(argv: list[str]) -> int:
+    """Print the Main Tree as BehaviorTree.CPP v4 XML or ASCII."""
+    args = tree_parser().parse_args(argv)
+    sys.stdout.write(export.render(export.exportable_tree(), args.format))
+    return 0
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Entry point; returns the exit code."""
+    argv = sys.argv[1:] if argv is None else list(argv)
+    if argv[:1] == ["tree"]:
+        return tree_command(argv[1:])
+    args = parser().parse_args(argv)
+    bus_config = start(args, "agent")
+    try:
+        config = AgentConfig.from_env(tick_hz=args.tick_hz, agent_link_timeout_s=args.link_timeout)
+        scenario = scenarios.load(args.scenario)
+    except (ValueError, LinecrewError) as exc:
+        log.error("cannot start: %s", exc)
+        return 2
+    shutdown = Shutdown().install()
+    stop = shutdown.wait_async()
+    try:
+        asyncio.run(
+            run_agent(
+                args.uav,
+                scenario,
+                args.autopilot,
+                bus_config,
+                config,
+                stop,
+                args.site,
+                args.speedup,
+            )
+        )
+    except LinecrewError as exc:
+        log.error("agent failed: %s", exc)
+        return 1
+    log.info("stopped on %s", shutdown.signal_name or "request")
+    return 0

@@ -1,0 +1,170 @@
+"""The agent's task queue: plans in (with epoch fencing and validation),
+progress per task, outcomes out.
+
+Epoch fencing: a plan replaces the queue only if its epoch is newer than
+the one in force; an older or equal epoch is ignored, a plan addressed to
+another UAV is rejected (each of its tasks gets a failure outcome). Outcomes
+wait in an outbox until the comms layer can deliver them (so failures met
+while the ground station is unreachable are reported when it returns).
+"""
+
+from __future__ import annotations
+
+import collections
+import enum
+import logging
+from collections.abc import Callable
+
+from onboard_agent.validation import task_problem
+from proto.plan import InspectTask, MonitorTask, Plan, Task, Waypoint
+from proto.site import Site
+from proto.telemetry import OutcomeResult, TaskOutcome
+
+log = logging.getLogger(__name__)
+
+
+class PlanVerdict(enum.StrEnum):
+    """What :meth:`Mission.offer` did with a plan."""
+
+    ACCEPTED = "accepted"
+    STALE = "stale"
+    REJECTED = "rejected"
+
+
+class Mission:
+    """The queue of one UAV and the outcomes it owes the ground station."""
+
+    def __init__(self, uav_id: str, site: Site, wall: Callable[[], float]) -> None:
+        self.uav_id = uav_id
+        self.site = site
+        self.wall = wall
+        self.epoch = 0
+        self.tasks: collections.deque[Task] = collections.deque()
+        self.outbox: list[TaskOutcome] = []
+        self._waypoints_done: dict[str, list[int]] = {}
+        self._monitored_s: dict[str, float] = {}
+        self._failures: dict[str, int] = {}
+        self._started: set[str] = set()
+
+    # -- plans --------------------------------------------------------------------
+
+    def offer(self, plan: Plan) -> PlanVerdict:
+        """Adopt ``plan`` if it is for this UAV and newer than the one in force."""
+        if plan.uav_id != self.uav_id:
+            log.warning("rejected a plan for %s", plan.uav_id, extra={"uav_id": self.uav_id})
+            for task in plan.tasks:
+                reason = f"plan for {plan.uav_id} sent to {self.uav_id}"
+                self._report(task, OutcomeResult.FAILED, reason, plan.epoch)
+            return PlanVerdict.REJECTED
+        if plan.epoch <= self.epoch:
+            log.info("ignored plan epoch %d (holding %d)", plan.epoch, self.epoch)
+            return PlanVerdict.STALE
+        kept = {t.task_id for t in plan.tasks}
+        head = self.head
+        if head is not None and head.task_id in self._started and head.task_id not in kept:
+            self._report(head, OutcomeResult.ABORTED, f"replaced by plan epoch {plan.epoch}")
+        self.epoch = plan.epoch
+        self.tasks.clear()
+        for task in plan.tasks:
+            problem = task_problem(task, self.site)
+            if problem is None:
+                self.tasks.append(task)
+            else:
+                self._report(task, OutcomeResult.FAILED, f"rejected: {problem}")
+        log.info("plan epoch %d: %d tasks", plan.epoch, len(self.tasks))
+        return PlanVerdict.ACCEPTED
+
+    @property
+    def head(self) -> Task | None:
+        """The task to perform now."""
+        return self.tasks[0] if self.tasks else None
+
+    def start(self, task: Task) -> None:
+        """Note that work on ``task`` began (it is then reported if replaced)."""
+        self._started.add(task.task_id)
+
+    # -- progress -------------------------------------------------------------------
+
+    def waypoints_done(self, task_id: str) -> list[int]:
+        return list(self._waypoints_done.get(task_id, []))
+
+    def mark_waypoint(self, task: InspectTask, index: int) -> None:
+        done = self._waypoints_done.setdefault(task.task_id, [])
+        if index not in done:
+            done.append(index)
+
+    def next_waypoint(self, task: InspectTask) -> Waypoint | None:
+        """The first waypoint of ``task`` not visited yet."""
+        done = set(self._waypoints_done.get(task.task_id, []))
+        return next((w for w in task.waypoints if w.index not in done), None)
+
+    def monitored_s(self, task_id: str) -> float:
+        return self._monitored_s.get(task_id, 0.0)
+
+    def add_monitored(self, task_id: str, seconds: float) -> None:
+        self._monitored_s[task_id] = self.monitored_s(task_id) + max(0.0, seconds)
+
+    def progress(self, task: Task | None) -> float:
+        """Fraction of ``task`` done (0..1)."""
+        match task:
+            case InspectTask(waypoints=waypoints) if waypoints:
+                done = set(self._waypoints_done.get(task.task_id, []))
+                return len([w for w in waypoints if w.index in done]) / len(waypoints)
+            case MonitorTask(duration_s=duration):
+                return min(1.0, self.monitored_s(task.task_id) / duration)
+        return 0.0
+
+    def note_failure(self, task: Task) -> int:
+        """Count a failed attempt at ``task``; returns the attempts so far."""
+        self._failures[task.task_id] = self._failures.get(task.task_id, 0) + 1
+        return self._failures[task.task_id]
+
+    # -- endings --------------------------------------------------------------------
+
+    def complete(self, task: Task) -> None:
+        """``task`` (the head) succeeded: report it and move on."""
+        self._pop(task)
+        self._report(task, OutcomeResult.COMPLETED, "", progress=1.0)
+
+    def fail(self, task: Task, reason: str) -> None:
+        """``task`` (the head) failed: report it and move on."""
+        self._pop(task)
+        self._report(task, OutcomeResult.FAILED, reason)
+
+    def abandon(self, reason: str) -> int:
+        """Empty the queue (emergency protocol): every task fails with ``reason``."""
+        count = len(self.tasks)
+        while self.tasks:
+            self.fail(self.tasks[0], reason)
+        return count
+
+    def take_outcomes(self) -> list[TaskOutcome]:
+        """The outcomes not yet delivered; the outbox is emptied."""
+        outcomes, self.outbox = self.outbox, []
+        return outcomes
+
+    def _pop(self, task: Task) -> None:
+        if self.tasks and self.tasks[0].task_id == task.task_id:
+            self.tasks.popleft()
+
+    def _report(
+        self,
+        task: Task,
+        result: OutcomeResult,
+        reason: str,
+        epoch: int | None = None,
+        progress: float | None = None,
+    ) -> None:
+        outcome = TaskOutcome(
+            uav_id=self.uav_id,
+            task_id=task.task_id,
+            action_id=task.action_id,
+            epoch=self.epoch if epoch is None else epoch,
+            result=result,
+            reason=reason,
+            progress=self.progress(task) if progress is None else progress,
+            waypoints_done=self.waypoints_done(task.task_id),
+            stamp_s=self.wall(),
+        )
+        log.info("task %s %s %s", task.task_id, result, reason, extra={"uav_id": self.uav_id})
+        self.outbox.append(outcome)

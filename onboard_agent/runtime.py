@@ -1,0 +1,82 @@
+"""The agent process at run time: the MAVLink link, the bus, the comms and
+the tick loop, started together and stopped together."""
+
+from __future__ import annotations
+
+import asyncio
+import contextlib
+import logging
+import time
+from collections.abc import Awaitable
+
+from linecrew.bus import Bus, BusConfig
+from linecrew.clock import mission_clock
+from onboard_agent.agent import Agent
+from onboard_agent.autopilot.link import MavlinkLink
+from onboard_agent.comms import Comms
+from onboard_agent.config import AgentConfig
+from proto.geo import LocalFrame
+from proto.keys import KeySpace
+from proto.scenario import Scenario
+
+log = logging.getLogger(__name__)
+
+
+async def tick_loop(agent: Agent, comms: Comms) -> None:
+    """Tick at ``tick_hz`` on the monotonic clock (no drift, no bursts)."""
+    period = 1.0 / agent.ctx.config.tick_hz
+    next_at = time.monotonic()
+    while True:
+        try:
+            agent.tick()
+        except Exception:  # a bug in one behaviour must not stop the UAV being reported
+            log.exception("tick failed", extra={"uav_id": agent.ctx.uav_id})
+        comms.after_tick(time.monotonic())
+        next_at = max(next_at + period, time.monotonic())
+        await asyncio.sleep(max(0.0, next_at - time.monotonic()))
+
+
+async def run_agent(
+    uav_id: str,
+    scenario: Scenario,
+    autopilot_url: str,
+    bus_config: BusConfig,
+    config: AgentConfig,
+    stop: Awaitable[None],
+    site: str | None = None,
+    speedup: float = 1.0,
+) -> None:
+    """Fly ``uav_id`` until ``stop`` completes; then stop ticking and close
+    the bus and the MAVLink link. Keys use ``site`` (default: the scenario's).
+    Task durations and plan times run on the mission clock (``speedup``);
+    link timeouts on real time."""
+    link = MavlinkLink(autopilot_url, LocalFrame(scenario.site.origin), config)
+    agent = Agent(
+        uav_id,
+        scenario,
+        link,
+        config,
+        clock=lambda: time.monotonic() * speedup,
+        wall=mission_clock(speedup),
+    )
+    bus = await asyncio.to_thread(Bus.open, bus_config)
+    link.start()
+    try:
+        comms = Comms(bus, KeySpace(site or scenario.site.id), agent)
+        tasks = [
+            asyncio.create_task(link.run(), name="mavlink"),
+            asyncio.create_task(comms.run(), name="comms"),
+            asyncio.create_task(tick_loop(agent, comms), name="ticks"),
+        ]
+        log.info("agent %s up, autopilot %s", uav_id, autopilot_url, extra={"uav_id": uav_id})
+        stopper = asyncio.ensure_future(stop)
+        await asyncio.wait([stopper, *tasks], return_when=asyncio.FIRST_COMPLETED)
+        for task in [stopper, *tasks]:
+            task.cancel()
+        for task in tasks:
+            with contextlib.suppress(asyncio.CancelledError):
+                await task  # re-raises a component's crash
+    finally:
+        link.close()
+        bus.close()
+        log.info("agent %s stopped", uav_id, extra={"uav_id": uav_id})

@@ -1,0 +1,62 @@
+"""What the agent knows about the site: stations, tool stations and where
+the workers are (their last tracked pose, else where the site puts them)."""
+
+from __future__ import annotations
+
+import math
+
+from proto.geo import Point
+from proto.site import ChargingStation, Site, ToolStation
+from proto.telemetry import HumanPose
+
+
+def horizontal_distance(a: Point, b: Point) -> float:
+    """Distance in the horizontal plane, metres."""
+    return math.hypot(a.x_m - b.x_m, a.y_m - b.y_m)
+
+
+class Surroundings:
+    """The site plus the latest human poses."""
+
+    def __init__(self, site: Site) -> None:
+        self.site = site
+        self._poses: dict[str, HumanPose] = {}
+
+    def update_pose(self, pose: HumanPose) -> None:
+        """Keep the newest pose of each worker (older stamps are ignored)."""
+        known = self._poses.get(pose.worker_id)
+        if known is None or pose.stamp_s >= known.stamp_s:
+            self._poses[pose.worker_id] = pose
+
+    def worker_position(self, worker_id: str) -> Point | None:
+        """Tracked position of a worker, else the site's; None if unknown."""
+        pose = self._poses.get(worker_id)
+        if pose is not None:
+            return pose.position
+        worker = self.site.worker(worker_id)
+        return worker.position if worker is not None else None
+
+    def station(self, station_id: str) -> ChargingStation | None:
+        return self.site.station(station_id)
+
+    def nearest_station(self, where: Point) -> ChargingStation | None:
+        """The charging station closest (horizontally) to ``where``."""
+        stations = self.site.stations
+        if not stations:
+            return None
+        return min(stations, key=lambda s: horizontal_distance(s.position, where))
+
+    def tool_station(self, station_id: str) -> ToolStation | None:
+        return self.site.tool_station(station_id)
+
+    def tool_station_for(self, tool: str) -> ToolStation | None:
+        """A tool station stocking ``tool`` (the first one), if any."""
+        return next(
+            (ts for ts in self.site.tool_stations if any(t.name == tool for t in ts.tools)), None
+        )
+
+    def nearest_tool_station(self, where: Point) -> ToolStation | None:
+        stations = self.site.tool_stations
+        if not stations:
+            return None
+        return min(stations, key=lambda s: where.distance_to(s.position))

@@ -1,0 +1,124 @@
+"""Where each "go near X" leads and when the UAV counts as near X.
+
+A :class:`Target` locates a point from the context (None when it cannot be
+known) and says how close is close enough; the "Is Agent near X?" condition
+and the "Go near X" action share it, so they always agree.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from collections.abc import Callable
+
+from onboard_agent.context import Context
+from onboard_agent.surroundings import horizontal_distance
+from proto.geo import Point
+from proto.plan import DeliverTask, GoHomeTask, InspectTask, MonitorTask, PickTask, RechargeTask
+
+
+@dataclasses.dataclass(frozen=True)
+class Target:
+    """A named place; ``horizontal`` targets ignore altitude when judging nearness."""
+
+    label: str
+    locate: Callable[[Context], Point | None]
+    radius_m: Callable[[Context], float]
+    horizontal: bool = False
+    settle: bool = False  # near only once hovering (to grab, release or land)
+
+    def distance(self, ctx: Context, point: Point) -> float:
+        here = ctx.vehicle.position
+        return horizontal_distance(here, point) if self.horizontal else here.distance_to(point)
+
+    def reached(self, ctx: Context) -> bool:
+        point = self.locate(ctx)
+        if point is None or not ctx.vehicle.known:
+            return False
+        near = self.distance(ctx, point) <= self.radius_m(ctx)
+        slow = ctx.vehicle.speed_mps <= ctx.config.settle_speed_mps
+        return near and (slow or not self.settle)
+
+
+def _above(point: Point, height_m: float) -> Point:
+    return Point(x_m=point.x_m, y_m=point.y_m, z_m=point.z_m + height_m)
+
+
+def waypoint(ctx: Context) -> Point | None:
+    task = ctx.mission.head
+    if not isinstance(task, InspectTask):
+        return None
+    wp = ctx.mission.next_waypoint(task)
+    return wp.position if wp is not None else None
+
+
+def monitor_slot(ctx: Context) -> Point | None:
+    """Slot ``slot`` of ``slots`` on a circle of ``standoff_m`` around the worker."""
+    task = ctx.mission.head
+    if not isinstance(task, MonitorTask):
+        return None
+    worker = ctx.surroundings.worker_position(task.worker_id)
+    if worker is None:
+        return None
+    angle = 2 * math.pi * task.slot / task.slots
+    return Point(
+        x_m=worker.x_m + task.standoff_m * math.cos(angle),
+        y_m=worker.y_m + task.standoff_m * math.sin(angle),
+        z_m=worker.z_m,
+    )
+
+
+def drop_point(ctx: Context) -> Point | None:
+    """Above the worker of the head delivery task."""
+    task = ctx.mission.head
+    if not isinstance(task, DeliverTask):
+        return None
+    worker = ctx.surroundings.worker_position(task.worker_id)
+    return _above(worker, ctx.config.deliver_height_m) if worker is not None else None
+
+
+def pick_point(ctx: Context) -> Point | None:
+    """Above the tool station of the head pick task (or one stocking the tool)."""
+    task = ctx.mission.head
+    station = None
+    if isinstance(task, PickTask):
+        station = ctx.surroundings.tool_station(task.tool_station_id)
+    elif isinstance(task, DeliverTask):
+        station = ctx.surroundings.tool_station_for(task.tool)
+    return _above(station.position, ctx.config.pick_height_m) if station is not None else None
+
+
+def return_point(ctx: Context) -> Point | None:
+    """Above the tool station where the held tool came from (else the nearest)."""
+    station = None
+    if ctx.tool_station_id is not None:
+        station = ctx.surroundings.tool_station(ctx.tool_station_id)
+    if station is None:
+        station = ctx.surroundings.nearest_tool_station(ctx.vehicle.position)
+    return _above(station.position, ctx.config.pick_height_m) if station is not None else None
+
+
+def task_station(ctx: Context) -> Point | None:
+    """Above the station of the head recharge / go-home task."""
+    task = ctx.mission.head
+    if not isinstance(task, RechargeTask | GoHomeTask):
+        return None
+    station = ctx.surroundings.station(task.station_id)
+    return _above(station.position, ctx.config.approach_alt_m) if station is not None else None
+
+
+def nearest_station(ctx: Context) -> Point | None:
+    """Above the charging station nearest to the UAV."""
+    station = ctx.surroundings.nearest_station(ctx.vehicle.position)
+    return _above(station.position, ctx.config.approach_alt_m) if station is not None else None
+
+
+WAYPOINT = Target("WP", waypoint, lambda c: c.config.near_waypoint_m)
+HUMAN_SLOT = Target("Human Target", monitor_slot, lambda c: c.config.near_slot_m)
+HUMAN_DROP = Target("Human Target", drop_point, lambda c: c.config.near_human_m, settle=True)
+TOOL_STATION = Target("Station", pick_point, lambda c: c.config.near_tool_station_m, settle=True)
+TOOL_RETURN = Target("Station", return_point, lambda c: c.config.near_tool_station_m, settle=True)
+TASK_STATION = Target("Charging Station", task_station, lambda c: c.config.near_station_m, True)
+NEAREST_STATION = Target(
+    "Charging Station", nearest_station, lambda c: c.config.near_station_m, True
+)

@@ -1,0 +1,46 @@
+"""Checks a plan's tasks against what this agent knows, before it flies them.
+
+A task that names an unknown station, tool station or worker, or an
+inspection without waypoints, is rejected with a failure outcome instead of
+failing (or crashing) half-way.
+"""
+
+from __future__ import annotations
+
+from proto.plan import (
+    DeliverTask,
+    GoHomeTask,
+    InspectTask,
+    MonitorTask,
+    PickTask,
+    RechargeTask,
+    Task,
+    WaitTask,
+)
+from proto.site import Site
+
+
+def task_problem(task: Task, site: Site) -> str | None:
+    """Why ``task`` cannot be flown here, or None if it can."""
+    match task:
+        case InspectTask(waypoints=[]):
+            return "inspection without waypoints"
+        case InspectTask():
+            return None
+        case MonitorTask(worker_id=worker) | DeliverTask(worker_id=worker):
+            if site.worker(worker) is None:
+                return f"unknown worker {worker!r}"
+            if isinstance(task, MonitorTask) and task.slot >= task.slots:
+                return f"slot {task.slot} out of {task.slots}"
+            return None
+        case PickTask(tool_station_id=station_id):
+            if site.tool_station(station_id) is None:
+                return f"unknown tool station {station_id!r}"
+            return None
+        case RechargeTask(station_id=station_id) | GoHomeTask(station_id=station_id):
+            if site.station(station_id) is None:
+                return f"unknown station {station_id!r}"
+            return None
+        case WaitTask():
+            return None
+    return f"unsupported task {type(task).__name__}"

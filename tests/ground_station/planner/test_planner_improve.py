@@ -1,0 +1,53 @@
+"""Improvement only ever returns a valid plan at least as good as its input
+(and as the plain paper heuristic)."""
+
+from __future__ import annotations
+
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from ground_station.planner import Options, generate, plan, score, validate
+from ground_station.planner.export import export
+from ground_station.planner.heuristic import build
+from ground_station.planner.improve import improve, objective
+
+
+@settings(max_examples=8, deadline=None)
+@given(st.integers(2, 8), st.integers(2, 16), st.integers(0, 10_000))
+def test_improved_plan_is_valid_and_never_worse(n_uavs, n_actions, seed) -> None:
+    problem = generate(n_uavs, n_actions, seed)
+    base = plan(problem)
+    paper = plan(problem, Options(mode="paper"))
+    better = plan(problem, max_rounds=30)
+    assert validate(problem, better) == []
+    assert score(better) <= score(base)
+    assert score(better) <= score(paper)
+
+
+def test_improvement_rounds_only_accept_strict_gains() -> None:
+    problem = generate(6, 20, 4)
+    ctx = build(problem)
+    before = objective(ctx)
+    accepted = improve(ctx, lambda: False, max_rounds=40)
+    after = objective(ctx)
+    assert after <= before
+    assert (accepted > 0) == (after < before)
+    assert validate(problem, export(ctx)) == []
+
+
+def test_should_stop_is_honoured() -> None:
+    problem = generate(6, 20, 5)
+    calls = []
+
+    def stop() -> bool:
+        calls.append(1)
+        return len(calls) > 3
+
+    ctx = build(problem)
+    improve(ctx, stop)
+    assert len(calls) == 4
+
+
+def test_improvement_is_deterministic() -> None:
+    problem = generate(5, 15, 9)
+    assert plan(problem, max_rounds=25) == plan(problem, max_rounds=25)

@@ -1,0 +1,81 @@
+"""Shared pads, mid-task recharges and time-preserving removal."""
+
+from __future__ import annotations
+
+from itertools import pairwise
+
+import msgspec
+
+from ground_station.planner import (
+    InspectAction,
+    Problem,
+    Station,
+    Waypoint,
+    generate,
+    plan,
+    validate,
+)
+from ground_station.planner.export import export
+from ground_station.planner.heuristic import build
+from ground_station.planner.removal import remove_in_place
+
+replace = msgspec.structs.replace
+
+
+def test_one_pad_is_shared_in_turn(fig6: Problem) -> None:
+    pad = Station(id="P", position_m=(0.0, 0.0, 0.0), pads=1, recharge="charge", full_charge_s=300)
+    low = [replace(u, position_m=(0.0, 0.0, 0.0), energy_wh=15.0) for u in fig6.uavs]
+    landing_only = tuple(replace(s, pads=0) for s in fig6.stations)
+    far = InspectAction(
+        id="far",
+        waypoints=tuple(
+            Waypoint(position_m=(x, 30.0, 5.0), service_s=20.0) for x in (-20.0, 0.0, 20.0, 40.0)
+        ),
+    )
+    problem = replace(fig6, stations=(pad, *landing_only), uavs=tuple(low), actions=(far,))
+    result = plan(problem)
+    assert validate(problem, result) == []
+    on_pad = sorted(
+        (s.arrive_s, s.end_s)
+        for u in result.uavs
+        for s in u.steps
+        if s.kind == "recharge" and s.station == "P"
+    )
+    assert len(on_pad) >= 2
+    for (_, end), (start, _) in pairwise(on_pad):
+        assert start >= end - 1e-6
+
+
+def test_long_inspection_is_split_by_a_recharge(fig6: Problem) -> None:
+    line = InspectAction(
+        id="line",
+        waypoints=tuple(
+            Waypoint(position_m=(x, 12.0, 3.0), service_s=40.0) for x in range(-8, 9, 2)
+        ),
+    )
+    one = (replace(fig6.uavs[1], energy_wh=100.0),)
+    problem = replace(fig6, uavs=one, actions=(line,))
+    result = plan(problem)
+    assert validate(problem, result) == []
+    kinds = [s.kind for s in result.uavs[0].steps]
+    first, last = kinds.index("inspect"), len(kinds) - 1 - kinds[::-1].index("inspect")
+    assert "recharge" in kinds[first:last]  # the inspection resumes after recharging
+    assert sorted(s.index for s in result.uavs[0].steps if s.kind == "inspect") == list(range(9))
+
+
+def test_time_preserving_removal_keeps_other_steps_in_time() -> None:
+    problem = generate(8, 24, 11)
+    ctx = build(problem)
+    uid, route = max(ctx.routes.items(), key=lambda kv: len(kv[1].tasks))
+    victim = route.tasks[0].action_id
+    kept_before = [s for s in route.steps if s[6] not in (None, victim)]
+    assert remove_in_place(ctx, uid, lambda t: t.action_id == victim) is not None
+    kept_after = [s for s in ctx.routes[uid].steps if s[6] is not None]
+    assert [(s[0], s[2], s[3]) for s in kept_after] == [(s[0], s[2], s[3]) for s in kept_before]
+    # Remove the victim everywhere and check the whole plan still validates.
+    for other in ctx.placed_uavs(victim):
+        assert remove_in_place(ctx, other, lambda t: t.action_id == victim) is not None
+    ctx.unplaced.pop(victim, None)
+    smaller = replace(problem, actions=tuple(a for a in problem.actions if a.id != victim))
+    ctx.problem = smaller
+    assert validate(smaller, export(ctx)) == []

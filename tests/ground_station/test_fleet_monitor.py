@@ -1,0 +1,89 @@
+"""The watchdog on a fake clock: brief drop-outs change nothing, long ones
+make a UAV lost, its return makes it back."""
+
+from __future__ import annotations
+
+import pytest
+
+from ground_station.fleet_monitor import Change, FleetMonitor
+from proto import AgentState, AgentStatus, FlightState, GeoPoint, Point, Telemetry, UavOpState
+
+
+def telemetry(uav: str, flight: FlightState = FlightState.FLYING) -> Telemetry:
+    return Telemetry(
+        uav_id=uav,
+        stamp_s=0,
+        position=Point(x_m=0, y_m=0),
+        geo=GeoPoint(),
+        battery_wh=10,
+        battery_fraction=0.5,
+        flight_state=flight,
+    )
+
+
+def present(monitor: FleetMonitor, uav: str, now: float) -> None:
+    monitor.on_token(uav, True, now)
+    monitor.on_telemetry(telemetry(uav), now)
+
+
+def test_never_heard_uavs_start_lost_without_an_event():
+    monitor = FleetMonitor(["u1"], 5.0)
+    assert monitor.state("u1") == UavOpState.LOST
+    assert monitor.check(100.0) == []
+
+
+def test_appearing_is_back_and_a_short_silence_changes_nothing():
+    monitor = FleetMonitor(["u1"], 5.0)
+    present(monitor, "u1", 0.0)
+    assert monitor.check(0.0) == [("u1", Change.BACK)]
+    present(monitor, "u1", 1.0)
+    monitor.on_token("u1", False, 1.0)
+    assert monitor.check(5.9) == []  # 4.9 s of silence: within the grace
+    assert monitor.silence_s("u1", 5.9) == pytest.approx(4.9)
+    present(monitor, "u1", 5.9)
+    assert monitor.check(6.0) == []
+    assert monitor.state("u1") == UavOpState.IDLE
+
+
+def test_token_loss_longer_than_the_timeout_is_lost_once():
+    monitor = FleetMonitor(["u1"], 5.0)
+    present(monitor, "u1", 0.0)
+    monitor.check(0.0)
+    monitor.on_token("u1", False, 1.0)
+    monitor.on_telemetry(telemetry("u1"), 3.0)  # late samples do not hide a lost token
+    assert monitor.check(5.5) == []
+    assert monitor.check(6.0) == [("u1", Change.LOST)]
+    assert monitor.check(7.0) == []
+    assert monitor.state("u1") == UavOpState.LOST
+    assert not monitor.available("u1")
+
+
+def test_stale_telemetry_with_a_live_token_is_lost_too():
+    monitor = FleetMonitor(["u1"], 5.0)
+    present(monitor, "u1", 0.0)
+    monitor.check(0.0)
+    assert monitor.check(4.99) == []
+    assert monitor.check(5.0) == [("u1", Change.LOST)]
+    present(monitor, "u1", 9.0)
+    assert monitor.check(9.0) == [("u1", Change.BACK)]
+
+
+def test_states_follow_the_agent_and_crashes():
+    monitor = FleetMonitor(["u1"], 5.0)
+    present(monitor, "u1", 0.0)
+    monitor.check(0.0)
+    assert monitor.state("u1") == UavOpState.IDLE
+    monitor.on_status(AgentStatus(uav_id="u1", stamp_s=0, state=AgentState.RECHARGING))
+    assert monitor.state("u1") == UavOpState.RECHARGING and monitor.available("u1")
+    monitor.on_status(AgentStatus(uav_id="u1", stamp_s=0, state=AgentState.EMERGENCY))
+    assert not monitor.available("u1")
+    monitor.on_telemetry(telemetry("u1", FlightState.CRASHED), 1.0)
+    assert monitor.state("u1") == UavOpState.FAILED
+
+
+def test_unknown_uavs_are_ignored():
+    monitor = FleetMonitor(["u1"], 5.0)
+    monitor.on_token("intruder", True, 0.0)
+    monitor.on_telemetry(telemetry("intruder"), 0.0)
+    assert not monitor.known("intruder")
+    assert [s.uav_id for s in monitor.snapshot()] == ["u1"]

@@ -1,0 +1,195 @@
+"""The mission manager with the real planner and a real SQLite file."""
+
+from __future__ import annotations
+
+import pytest
+
+from ground_station.missions import Conflict, NotFound
+from ground_station.validation import InvalidAction
+from proto import (
+    ActionState,
+    CancelAction,
+    EventKind,
+    InspectTask,
+    ModifyAction,
+    OutcomeResult,
+    PickTask,
+    SubmitAction,
+    TaskOutcome,
+)
+from tests.ground_station.harness import Harness
+
+ALL = ("uav-1", "uav-2", "uav-3")
+
+
+@pytest.fixture
+def gs(tmp_path):
+    harness = Harness(str(tmp_path / "gs.db"))
+    harness.bring_up(*ALL)
+    assert sorted(p.uav_id for p in harness.sent) == list(ALL)  # each gets a fresh plan
+    harness.sent.clear()
+    return harness
+
+
+def test_a_new_action_is_stored_planned_and_sent_to_the_capable_uav(gs):
+    record = gs.submit("deliver-wrench")
+    assert record.state == ActionState.PLANNED
+    plan = gs.latest("uav-1")
+    assert [type(t) for t in plan.tasks][:2] == [PickTask, type(plan.tasks[1])]
+    assert plan.tasks[0].action_id == "deliver-wrench"
+    assert all(p.uav_id == "uav-1" for p in gs.sent)  # nobody else's work changed
+    kinds = [e.kind for e in gs.events]
+    assert EventKind.ACTION_ACCEPTED in kinds and EventKind.PLAN_CHANGED in kinds
+    assert gs.store.action("deliver-wrench").state == ActionState.PLANNED
+
+
+def test_submission_is_idempotent_on_the_request_id(gs):
+    first = gs.submit("inspect-loop", request_id="same")
+    sent = len(gs.sent)
+    again = gs.submit("inspect-loop", request_id="same")
+    assert again == first and len(gs.sent) == sent
+    assert len(gs.store.actions()) == 1
+    other = gs.scenario.actions[0].action
+    with pytest.raises(Conflict) as caught:
+        gs.manager.submit(SubmitAction(request_id="same", action=other))
+    assert caught.value.field == "request_id"
+
+
+def test_an_invalid_action_is_refused_and_nothing_is_stored(gs):
+    bad = SubmitAction(
+        request_id="r",
+        action=gs.scenario.actions[2].action.__class__(worker_id="nobody", duration_s=5),
+    )
+    with pytest.raises(InvalidAction):
+        gs.manager.submit(bad)
+    assert gs.store.actions() == [] and gs.sent == []
+
+
+def test_plans_carry_increasing_epochs(gs):
+    gs.submit("deliver-wrench")
+    gs.submit("inspect-loop")
+    epochs = [p.epoch for p in gs.sent]
+    assert epochs == sorted(epochs) and len(set(epochs)) >= 2
+
+
+def test_cancel_removes_the_work_and_is_idempotent(gs):
+    gs.submit("inspect-loop")
+    owner = gs.sent[-1].uav_id
+    record = gs.manager.cancel(CancelAction(request_id="c1", action_id="inspect-loop"))
+    assert record.state == ActionState.CANCELLED
+    assert not [t for t in gs.latest(owner).tasks if t.action_id == "inspect-loop"]
+    assert gs.manager.cancel(CancelAction(request_id="c2", action_id="inspect-loop")) == record
+    with pytest.raises(NotFound):
+        gs.manager.cancel(CancelAction(request_id="c3", action_id="nope"))
+
+
+def test_modify_changes_priority_and_refuses_finished_actions(gs):
+    gs.submit("inspect-loop")
+    record = gs.manager.modify(ModifyAction(request_id="m", action_id="inspect-loop", priority=9))
+    assert record.action.priority == 9
+    gs.manager.cancel(CancelAction(request_id="c", action_id="inspect-loop"))
+    with pytest.raises(Exception, match="cancelled"):
+        gs.manager.modify(ModifyAction(request_id="m2", action_id="inspect-loop", priority=1))
+
+
+def _inspect_task(gs, action_id: str):
+    for plan in reversed(gs.sent):
+        for task in plan.tasks:
+            if isinstance(task, InspectTask) and task.action_id == action_id:
+                return plan, task
+    raise AssertionError("no inspection task sent")
+
+
+def test_outcomes_complete_an_inspection_waypoint_by_waypoint(gs):
+    gs.submit("inspect-loop")
+    plan, task = _inspect_task(gs, "inspect-loop")
+    first_half = [w.index for w in task.waypoints[:4]]
+    gs.manager.on_outcome(
+        TaskOutcome(
+            uav_id=plan.uav_id,
+            task_id=task.task_id,
+            epoch=plan.epoch,
+            result=OutcomeResult.ABORTED,
+            progress=0.5,
+            waypoints_done=first_half,
+        )
+    )
+    record = gs.store.action("inspect-loop")
+    assert record.state == ActionState.IN_PROGRESS and record.waypoints_done == first_half
+    plan, task = _inspect_task(gs, "inspect-loop")
+    assert {w.index for w in task.waypoints}.isdisjoint(first_half)  # resumes, no repeats
+    gs.manager.on_outcome(
+        TaskOutcome(
+            uav_id=plan.uav_id,
+            task_id=task.task_id,
+            epoch=plan.epoch,
+            result=OutcomeResult.COMPLETED,
+            waypoints_done=[w.index for w in task.waypoints],
+        )
+    )
+    record = gs.store.action("inspect-loop")
+    assert record.state == ActionState.COMPLETED and record.progress == 1.0
+
+
+def test_stale_outcomes_are_recorded_but_change_nothing(gs):
+    gs.submit("inspect-loop")
+    plan, task = _inspect_task(gs, "inspect-loop")
+    other = next(u for u in ALL if u != plan.uav_id)
+    gs.manager.on_outcome(
+        TaskOutcome(
+            uav_id=other,
+            task_id=task.task_id,
+            epoch=plan.epoch,
+            result=OutcomeResult.COMPLETED,
+            waypoints_done=list(range(8)),
+        )
+    )
+    assert gs.store.action("inspect-loop").state == ActionState.PLANNED
+    assert gs.manager.counters.stale_outcomes == 1
+    assert gs.events[-1].kind == EventKind.FAULT
+
+
+def test_a_lost_uav_s_work_goes_to_another_and_it_gets_a_higher_epoch_back(gs):
+    gs.submit("inspect-loop")
+    plan, _ = _inspect_task(gs, "inspect-loop")
+    victim = plan.uav_id
+    others = [u for u in ALL if u != victim]
+    gs.monitor.on_token(victim, False, gs.now)
+    gs.advance(4.0)
+    gs.heartbeat(*others)
+    assert _inspect_task(gs, "inspect-loop")[0].uav_id == victim  # brief: nothing moved
+    gs.advance(1.5)
+    gs.heartbeat(*others)
+    new_plan, _ = _inspect_task(gs, "inspect-loop")
+    assert new_plan.uav_id != victim and new_plan.epoch > plan.epoch
+    assert any(e.kind == EventKind.UAV_LOST and e.uav_id == victim for e in gs.events)
+    assert gs.replanner.plans[victim].tasks == []
+    gs.bring_up(victim)
+    back = gs.latest(victim)
+    assert back.epoch > new_plan.epoch
+
+
+def test_nothing_accepted_is_lost_across_a_restart(tmp_path):
+    path = str(tmp_path / "gs.db")
+    first = Harness(path)
+    first.bring_up(*ALL)
+    first.submit("deliver-wrench")
+    first.submit("inspect-loop")
+    last_epoch = max(p.epoch for p in first.sent)
+    # no close(): the process "dies" here
+    second = Harness(path, now=2000.0)
+    assert {r.action_id for r in second.store.actions()} == {"deliver-wrench", "inspect-loop"}
+    assert second.replanner.plans.keys() == first.replanner.plans.keys()
+    second.bring_up(*ALL)
+    assert second.sent and min(p.epoch for p in second.sent) > last_epoch
+    assert {t.action_id for p in second.sent for t in p.tasks} >= {"deliver-wrench", "inspect-loop"}
+    assert second.events[0].seq > first.events[-1].seq
+
+
+def test_battery_below_the_plan_replans_once_per_epoch(gs):
+    gs.submit("inspect-loop")
+    plan, _ = _inspect_task(gs, "inspect-loop")
+    low = gs.telemetry(plan.uav_id, battery_wh=1.0)
+    gs.manager.on_telemetry(low)
+    gs.manager.on_telemetry(low)
+    assert gs.manager.counters.battery_replans == 1

@@ -1,0 +1,211 @@
+"""The ground-station process over a real router, with a real SQLite file and
+scripted agents: plans reach agents, drop-outs, stale outcomes, kill -9 and
+restart, hostile RPC payloads."""
+
+from __future__ import annotations
+
+import sys
+import time
+
+import pytest
+
+from ground_station.light_agent import LightAgent
+from linecrew.bus import Bus
+from linecrew.scenarios import load
+from proto import (
+    ActionList,
+    ActionReply,
+    ActionState,
+    EventKind,
+    GetHistory,
+    GetMetrics,
+    HistoryReply,
+    InspectTask,
+    KeySpace,
+    ListActions,
+    MetricsReply,
+    OutcomeResult,
+    PickTask,
+    RequestError,
+    Role,
+    SubmitAction,
+    TaskOutcome,
+)
+from tests.support.processes import Process, running, wait_until
+
+SCENARIO = load("paper")
+KEYS = KeySpace(SCENARIO.site.id)
+UAVS = [u.id for u in SCENARIO.fleet.uavs]
+LINK_TIMEOUT_S = 2.0
+
+
+def gs_args(router: str, db: str) -> list[str]:
+    return [
+        sys.executable,
+        "-m",
+        "ground_station",
+        "--connect",
+        router,
+        "--db",
+        db,
+        "--link-timeout",
+        str(LINK_TIMEOUT_S),
+        "--lease-ms",
+        "500",
+    ]
+
+
+@pytest.fixture
+def client(bus_config):
+    with Bus.open(bus_config) as bus:
+        yield bus
+
+
+def gs_alive(client: Bus) -> bool:
+    return bool(client.alive(KEYS.all_alive(Role.GROUND_STATION)))
+
+
+@pytest.fixture
+def gs(router, client, tmp_path):
+    with running(gs_args(router, str(tmp_path / "gs.db")), "gs", lambda: gs_alive(client)) as p:
+        yield p
+
+
+@pytest.fixture
+def agents(bus_config, gs):
+    fleet = {u: LightAgent(bus_config, SCENARIO, u) for u in UAVS}
+    try:
+        wait_until(lambda: all(a.plans for a in fleet.values()), 15, "a first plan for every UAV")
+        yield fleet
+    finally:
+        for agent in fleet.values():
+            agent.close()
+
+
+def submit(client: Bus, name: str) -> ActionReply:
+    scripted = next(a for a in SCENARIO.actions if a.id == name)
+    request = SubmitAction(request_id=f"r-{name}", action=scripted.action, action_id=name)
+    return client.query(KEYS.rpc("submit"), request, ActionReply, 5.0)
+
+
+def history(client: Bus) -> HistoryReply:
+    return client.query(KEYS.rpc("history"), GetHistory(limit=1000), HistoryReply, 5.0)
+
+
+def owner_of(agents: dict[str, LightAgent], action_id: str) -> LightAgent | None:
+    for agent in agents.values():
+        plan = agent.latest()
+        if plan and any(t.action_id == action_id for t in plan.tasks):
+            return agent
+    return None
+
+
+def test_a_new_action_reaches_the_capable_agent(client, agents):
+    reply = submit(client, "deliver-wrench")
+    assert reply.record.state == ActionState.PLANNED
+    uav1 = agents["uav-1"]
+    wait_until(
+        lambda: uav1.latest().tasks and isinstance(uav1.latest().tasks[0], PickTask),
+        10,
+        "the pick task at uav-1",
+    )
+    assert owner_of(agents, "deliver-wrench") is uav1
+
+
+def test_brief_drop_out_changes_nothing_and_a_long_one_moves_the_work(client, agents):
+    submit(client, "inspect-loop")
+    wait_until(lambda: owner_of(agents, "inspect-loop"), 10, "inspection planned")
+    victim = owner_of(agents, "inspect-loop")
+    victim.go_silent()
+    time.sleep(LINK_TIMEOUT_S / 4)  # well inside the grace: must change nothing
+    victim.speak_again()
+    events = history(client).events
+    assert not [e for e in events if e.kind == EventKind.UAV_LOST]
+    victim.go_silent()
+    wait_until(lambda: owner_of(agents, "inspect-loop") not in (None, victim), 15, "work moved")
+    lost = [e for e in history(client).events if e.kind == EventKind.UAV_LOST]
+    assert [e.uav_id for e in lost] == [victim.uav_id]
+    victim.speak_again()
+    moved_epoch = owner_of(agents, "inspect-loop").latest().epoch
+    wait_until(lambda: victim.latest().epoch > moved_epoch, 15, "a fresh plan for the returner")
+
+
+def test_stale_outcomes_are_recorded_but_do_not_change_state(client, agents):
+    submit(client, "inspect-loop")
+    wait_until(lambda: owner_of(agents, "inspect-loop"), 10, "inspection planned")
+    owner = owner_of(agents, "inspect-loop")
+    task = next(t for t in owner.latest().tasks if isinstance(t, InspectTask))
+    impostor = next(a for a in agents.values() if a is not owner)
+    impostor.bus.publish(
+        KEYS.outcome(impostor.uav_id),
+        TaskOutcome(
+            uav_id=impostor.uav_id,
+            task_id=task.task_id,
+            epoch=owner.latest().epoch,
+            result=OutcomeResult.COMPLETED,
+            waypoints_done=list(range(8)),
+        ),
+    )
+    wait_until(
+        lambda: any(
+            e.kind == EventKind.FAULT and "stale" in e.detail for e in history(client).events
+        ),
+        10,
+        "stale outcome recorded",
+    )
+    actions = client.query(KEYS.rpc("list_actions"), ListActions(), ActionList, 5.0)
+    assert [r.state for r in actions.records] == [ActionState.PLANNED]
+
+
+def test_kill_9_and_restart_loses_nothing_accepted(router, client, agents, gs, tmp_path):
+    for name in ("deliver-wrench", "inspect-loop", "monitor-w2"):
+        submit(client, name)
+    before = {a.uav_id: a.latest().epoch for a in agents.values()}
+    gs.kill()
+    wait_until(lambda: not gs_alive(client), 10, "ground station gone")
+    restarted = Process(gs_args(router, str(tmp_path / "gs.db")), "gs-restarted")
+    try:
+        wait_until(lambda: gs_alive(client), 20, "ground station back")
+        actions = client.query(KEYS.rpc("list_actions"), ListActions(), ActionList, 5.0)
+        assert {r.action_id for r in actions.records} == {
+            "deliver-wrench",
+            "inspect-loop",
+            "monitor-w2",
+        }
+        wait_until(
+            lambda: all(a.latest().epoch > before[a.uav_id] for a in agents.values()),
+            15,
+            "fresh plans with higher epochs",
+        )
+        planned = {t.action_id for a in agents.values() for t in a.latest().tasks}
+        assert {"deliver-wrench", "inspect-loop", "monitor-w2"} <= planned
+    finally:
+        assert restarted.stop() == 0, restarted.output()
+
+
+@pytest.mark.parametrize("payload", [b"", b"\xc1", b"\x81\xa4type\xa6submit", b"x" * 5000])
+def test_hostile_rpc_payloads_get_error_replies_and_the_gs_keeps_serving(client, gs, payload):
+    for op in ("submit", "cancel", "history"):
+        replies = list(client.session.get(KEYS.rpc(op), payload=payload, timeout=5.0))
+        assert len(replies) == 1 and replies[0].err is not None
+    with pytest.raises(RequestError) as caught:
+        client.query(KEYS.rpc("cancel"), GetHistory(), HistoryReply, 5.0)
+    assert caught.value.code == "wrong_op"
+    metrics = client.query(KEYS.rpc("metrics"), GetMetrics(), MetricsReply, 5.0)
+    assert "replans" in metrics.values
+    assert gs.popen.poll() is None
+
+
+def test_an_invalid_submission_names_the_field(client, gs):
+    bad = SubmitAction(
+        request_id="bad",
+        action=SCENARIO.actions[2].action.__class__(worker_id="nobody", duration_s=5),
+    )
+    with pytest.raises(RequestError) as caught:
+        client.query(KEYS.rpc("submit"), bad, ActionReply, 5.0)
+    assert (caught.value.code, caught.value.field) == ("invalid_action", "action.worker_id")
+
+
+def test_sigterm_stops_the_ground_station_cleanly(gs):
+    assert gs.stop() == 0
+    assert "ground station stopped on SIGTERM" in gs.output()

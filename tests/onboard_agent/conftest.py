@@ -1,0 +1,141 @@
+"""Integration fixtures: a sim_fleet vehicle over real MAVLink, the agent as
+a real process, and a test-owned "ground station" on the real router."""
+
+from __future__ import annotations
+
+import sys
+import threading
+
+import msgspec
+import pytest
+
+from linecrew.bus import Bus
+from linecrew.scenarios import load
+from proto.keys import KeySpace, Role
+from proto.plan import Plan
+from proto.site import BatterySwap
+from proto.telemetry import AgentStatus, TaskOutcome
+from sim_fleet import Fleet, FleetConfig, FleetThread
+from sim_fleet.vehicle import AutopilotParams
+from tests.onboard_agent.simworld import sim_scenario, write_json
+from tests.support.processes import running, wait_until
+
+SPEEDUP = 10.0
+KEYS = KeySpace("default")
+
+
+def fast_scenario():
+    """The paper's world; C1 (uav-1's home pad) swaps batteries in 20 s so
+    that recharges stay short."""
+    scenario = load("paper")
+    stations = [
+        msgspec.structs.replace(s, recharge=BatterySwap(swap_s=20.0)) if s.id == "C1" else s
+        for s in scenario.site.stations
+    ]
+    site = msgspec.structs.replace(scenario.site, stations=stations)
+    return msgspec.structs.replace(scenario, site=site)
+
+
+class GroundStation:
+    """What the test sees of the system: a liveliness token it can drop,
+    plans it publishes, statuses and outcomes it collects."""
+
+    def __init__(self, bus: Bus, uav_id: str) -> None:
+        self.bus, self.uav_id = bus, uav_id
+        self.token = None
+        self.lock = threading.Lock()
+        self.statuses: list[AgentStatus] = []
+        self.outcomes: list[TaskOutcome] = []
+        bus.subscribe(KEYS.status(uav_id), AgentStatus, lambda _k, m: self._add(self.statuses, m))
+        bus.subscribe(KEYS.outcome(uav_id), TaskOutcome, lambda _k, m: self._add(self.outcomes, m))
+        self.up()
+
+    def _add(self, into: list, item) -> None:
+        with self.lock:
+            into.append(item)
+
+    def up(self) -> None:
+        self.token = self.bus.declare_token(KEYS.alive(Role.GROUND_STATION, "gs"))
+
+    def down(self) -> None:
+        self.token.close()
+
+    @property
+    def status(self) -> AgentStatus | None:
+        with self.lock:
+            return self.statuses[-1] if self.statuses else None
+
+    def send(self, plan: Plan, timeout_s: float = 10.0) -> None:
+        """Publish until the agent holds the plan's epoch (samples sent before
+        its subscriber exists are lost)."""
+
+        def held() -> bool:
+            status = self.status
+            if status is not None and status.epoch >= plan.epoch:
+                return True
+            self.bus.publish(KEYS.plan(self.uav_id), plan)
+            return False
+
+        wait_until(held, timeout_s, f"agent holding epoch {plan.epoch}")
+
+    def outcome(self, task_id: str) -> TaskOutcome | None:
+        with self.lock:
+            return next((o for o in self.outcomes if o.task_id == task_id), None)
+
+
+@pytest.fixture
+def fleet():
+    """The paper's fleet in sim_fleet at SPEEDUP, every vehicle on a free port."""
+    config = FleetConfig(
+        speedup=SPEEDUP, rate_hz=50.0, base_port=0, params=AutopilotParams(auto_disarm_s=30.0)
+    )
+    runner = FleetThread(Fleet(sim_scenario(fast_scenario()), config)).start()
+    try:
+        yield runner
+    finally:
+        runner.stop()
+
+
+@pytest.fixture
+def gs(bus_config):
+    with Bus.open(bus_config) as bus:
+        yield GroundStation(bus, "uav-1")
+
+
+@pytest.hookimpl(wrapper=True, tryfirst=True)
+def pytest_runtest_makereport(item, call):
+    report = yield
+    if report.when == "call":
+        item.call_failed = report.failed
+    return report
+
+
+@pytest.fixture
+def agent(request, router, fleet, gs, tmp_path):
+    """``python -m onboard_agent`` flying uav-1 of the fleet."""
+    path = write_json(fast_scenario(), tmp_path / "scenario.json")
+    args = [
+        sys.executable,
+        "-m",
+        "onboard_agent",
+        "--uav",
+        "uav-1",
+        "--autopilot",
+        f"udpout:127.0.0.1:{fleet.fleet.ports['uav-1']}",
+        "--scenario",
+        path,
+        "--connect",
+        router,
+        "--tick-hz",
+        "20",
+        "--link-timeout",
+        "1.5",
+        "--log-level",
+        "info",
+    ]
+    alive = KEYS.alive(Role.AGENT, "uav-1")
+    with running(args, "agent", lambda: gs.bus.alive(alive)) as proc:
+        yield proc
+        if getattr(request.node, "call_failed", False):
+            sys.stderr.write(f"--- agent log ---\n{proc.output()[-20000:]}\n")
+            sys.stderr.write(f"--- last status ---\n{gs.status}\n")

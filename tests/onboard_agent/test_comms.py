@@ -1,0 +1,75 @@
+"""The agent on a real router: resync by query, epoch fencing on the plan
+key, outcomes held while no ground station is alive, telemetry and status."""
+
+from __future__ import annotations
+
+import asyncio
+import time
+
+from linecrew.bus import Bus
+from onboard_agent.comms import Comms
+from proto.keys import KeySpace, Role
+from proto.rpc import GetPlans, PlansReply
+from proto.telemetry import AgentStatus, TaskOutcome, Telemetry
+from tests.onboard_agent.helpers import Rig, inspect_task, plan
+
+KEYS = KeySpace("default")
+
+
+async def until(predicate, timeout_s: float = 10.0, what: str = "") -> None:
+    deadline = time.monotonic() + timeout_s
+    while not predicate():
+        if time.monotonic() > deadline:
+            raise AssertionError(f"timed out waiting for {what or predicate}")
+        await asyncio.sleep(0.01)
+
+
+def test_comms_round_trip(bus_config):
+    rig = Rig(gs_alive=False)
+    mission = rig.mission
+    got: dict[str, list] = {"outcome": [], "status": [], "telemetry": []}
+    requests: list[GetPlans] = []
+
+    def serve_plans(request: GetPlans) -> PlansReply:
+        requests.append(request)
+        return PlansReply(plans=[plan(inspect_task("from-query"), epoch=7)])
+
+    async def main() -> None:
+        with Bus.open(bus_config) as agent_bus, Bus.open(bus_config) as gs_bus:
+            comms = Comms(agent_bus, KEYS, rig.agent)
+            gs_bus.serve(KEYS.plan("uav-1"), GetPlans, serve_plans)
+            for topic, kind in (
+                ("outcome", TaskOutcome),
+                ("status", AgentStatus),
+                ("telemetry", Telemetry),
+            ):
+                key = KEYS.uav("uav-1", topic)
+                gs_bus.subscribe(key, kind, lambda _k, m, t=topic: got[t].append(m))
+            running = asyncio.create_task(comms.run())
+            await until(lambda: gs_bus.alive(KEYS.alive(Role.AGENT, "uav-1")), what="agent token")
+
+            token = gs_bus.declare_token(KEYS.alive(Role.GROUND_STATION, "gs"))
+            await until(lambda: mission.epoch == 7, what="plan resync by query")
+            assert requests[0].uav_id == "uav-1"
+
+            gs_bus.publish(KEYS.plan("uav-1"), plan(inspect_task("old"), epoch=6))
+            gs_bus.publish(KEYS.plan("uav-1"), plan(inspect_task("new"), epoch=8))
+            await until(lambda: mission.epoch == 8, what="newer plan")
+            assert mission.head.task_id == "new"
+
+            token.close()
+            await until(lambda: not rig.agent.emergency.link_up, what="gs gone")
+            mission.fail(mission.head, "test failure")
+            comms.after_tick(0.0)
+            assert [o.task_id for o in mission.outbox] == ["new"]  # held back
+
+            token = gs_bus.declare_token(KEYS.alive(Role.GROUND_STATION, "gs"))
+            await until(lambda: rig.agent.emergency.link_up, what="gs back")
+            comms.after_tick(1.0)
+            await until(lambda: got["outcome"], what="outcome delivered")
+            assert got["outcome"][0].task_id == "new" and got["outcome"][0].epoch == 8
+            await until(lambda: got["telemetry"] and got["status"], what="telemetry and status")
+            running.cancel()
+            token.close()
+
+    asyncio.run(main())

@@ -1,0 +1,96 @@
+"""The MAVLink link against a sim_fleet vehicle over real UDP."""
+
+from __future__ import annotations
+
+import asyncio
+import time
+
+import pytest
+
+from onboard_agent import AgentConfig, CommandDenied, CommandTimeout
+from onboard_agent.autopilot.link import MavlinkLink
+from proto.geo import LocalFrame
+from proto.telemetry import FlightState
+from tests.onboard_agent.conftest import fast_scenario
+
+SITE = fast_scenario().site
+CONFIG = AgentConfig(command_ack_timeout_s=0.3, command_retries=1, heartbeat_timeout_s=0.5)
+
+
+async def until(predicate, timeout_s: float = 10.0, what: str = "") -> None:
+    deadline = time.monotonic() + timeout_s
+    while not predicate():
+        if time.monotonic() > deadline:
+            raise AssertionError(f"timed out waiting for {what or predicate}")
+        await asyncio.sleep(0.01)
+
+
+def fly(fleet, uav_id: str, scenario) -> None:
+    """Run ``scenario(link)`` with a link to ``uav_id`` of the fleet."""
+
+    async def main() -> None:
+        url = f"udpout:127.0.0.1:{fleet.fleet.ports[uav_id]}"
+        link = MavlinkLink(url, LocalFrame(SITE.origin), CONFIG)
+        link.start()
+        heartbeat = asyncio.create_task(link.run())
+        try:
+            await until(
+                lambda: (
+                    link.state.link_ok
+                    and link.state.known
+                    and link.state.battery_fraction > 0
+                    and link.state.flight_state is not FlightState.UNKNOWN
+                ),
+                what="telemetry",
+            )
+            await scenario(link)
+        finally:
+            heartbeat.cancel()
+            link.close()
+
+    asyncio.run(main())
+
+
+def test_guided_takeoff_goto_land_with_positions_in_the_site_frame(fleet):
+    async def scenario(link):
+        c1 = SITE.station("C1").position
+        assert link.state.position.distance_to(c1) < 0.1
+        assert link.state.landed and link.state.battery_fraction == 1.0
+        await link.set_mode("GUIDED")
+        await link.arm()
+        await link.takeoff(4.0)
+        await until(lambda: link.state.position.z_m > 3.9, what="climb")
+        assert link.state.armed and link.state.mode == "GUIDED"
+        target = c1.__class__(x_m=-5.0, y_m=10.0, z_m=4.0)
+        await link.goto(target)
+        await until(lambda: link.state.position.distance_to(target) < 0.2, what="arrival")
+        await link.land()
+        await until(lambda: link.state.landed and not link.state.armed, what="landing")
+
+    fly(fleet, "uav-1", scenario)
+
+
+def test_refused_command_carries_the_autopilot_reason(fleet):
+    async def scenario(link):
+        with pytest.raises(CommandDenied) as denied:
+            await link.grab()
+        assert denied.value.result == "UNSUPPORTED"
+        assert "Gripper: not fitted" in str(denied.value)
+        with pytest.raises(CommandDenied, match="takeoff FAILED"):
+            await link.takeoff(5.0)  # disarmed
+
+    fly(fleet, "uav-2", scenario)
+
+
+def test_silent_autopilot_times_out_and_is_reported(fleet):
+    vehicle = fleet.fleet.world.vehicle("uav-1")
+
+    async def scenario(link):
+        fleet.call(lambda: vehicle.drop_link(1e6))
+        with pytest.raises(CommandTimeout):
+            await link.arm()
+        await until(lambda: not link.state.link_ok, 5.0, "heartbeat loss")
+        fleet.call(lambda: setattr(vehicle, "link_down_until", 0.0))  # link back
+        await until(lambda: link.state.link_ok, 5.0, "heartbeat back")
+
+    fly(fleet, "uav-1", scenario)

@@ -1,0 +1,72 @@
+"""The Main Tree's priorities: mission over, battery, wrong tool, task."""
+
+from __future__ import annotations
+
+import py_trees
+
+from proto.telemetry import FlightState
+from tests.onboard_agent.helpers import SCENARIO, Rig, inspect_task, plan, point
+
+C1 = SCENARIO.site.station("C1").position
+C3 = SCENARIO.site.station("C3").position
+
+
+def flying_at(rig: Rig, where) -> None:
+    rig.autopilot.update(position=where, flight_state=FlightState.FLYING, armed=True, mode="GUIDED")
+
+
+def test_nothing_to_do_on_the_pad_sends_nothing():
+    rig = Rig()
+    rig.tick(20)
+    assert rig.autopilot.calls == []
+    assert rig.agent.active_path()[:3] == ["Main Tree", "Mission Over", "Back To Station"]
+    assert rig.agent.status().state == "idle"
+
+
+def test_mission_over_in_the_air_goes_back_to_the_nearest_station():
+    rig = Rig()
+    flying_at(rig, point(8, 9, 3))
+    rig.run_until(lambda: rig.autopilot.state.landed)
+    position = rig.autopilot.state.position
+    assert (position.x_m, position.y_m) == (C3.x_m, C3.y_m)
+    assert rig.autopilot.names()[-1] == "land"
+
+
+def test_low_battery_recharges_until_full_before_the_task():
+    rig = Rig(battery=0.22)
+    rig.agent.offer_plan(plan(inspect_task()))
+    rig.tick(3)
+    assert "Recharge" in rig.agent.active_path()
+    assert rig.agent.status().state == "recharging"
+    rig.autopilot.update(battery_fraction=0.6)  # enough again, but not full: keep charging
+    rig.tick(5)
+    assert rig.leaf() == "Recharge"
+    assert "takeoff" not in rig.autopilot.names()
+    rig.autopilot.update(battery_fraction=0.96)
+    rig.run_until(lambda: "takeoff" in rig.autopilot.names(), max_ticks=10)
+    rig.run_until(lambda: rig.mission.head is None)
+
+
+def test_battery_not_enough_in_flight_heads_for_the_nearest_charging_station():
+    rig = Rig(battery=0.3)
+    flying_at(rig, point(8, 9, 3))
+    far = inspect_task(n=3, service_s=200.0)  # hovering 200 s costs ~10 Wh
+    rig.agent.offer_plan(plan(far))
+    rig.tick()
+    assert "Recharge" in rig.agent.active_path()
+    assert rig.mission.head is far  # the task waits; nothing was abandoned
+    rig.run_until(lambda: rig.leaf() == "Recharge")
+    position = rig.autopilot.state.position
+    assert (position.x_m, position.y_m) == (C3.x_m, C3.y_m)
+
+
+def test_the_tree_never_finishes():
+    rig = Rig()
+    rig.agent.offer_plan(plan(inspect_task()))
+    for _ in range(300):
+        rig.tick()
+        assert rig.agent.tree.root.status in (
+            py_trees.common.Status.RUNNING,
+            py_trees.common.Status.SUCCESS,  # only via "Mission Over" (landed at a station)
+        )
+    assert rig.mission.head is None

@@ -1,0 +1,75 @@
+"""Monitoring Task Tree: the slot's stand-off point, following the worker."""
+
+from __future__ import annotations
+
+import math
+
+import pytest
+
+from proto.geo import GeoPoint
+from proto.plan import MonitorTask
+from proto.telemetry import HumanPose, OutcomeResult
+from tests.onboard_agent.helpers import SCENARIO, Rig, plan, point
+
+W2 = SCENARIO.site.worker("W2").position  # (-5, 15, 3)
+
+
+def monitor(slot: int = 1, slots: int = 4, duration_s: float = 3.0) -> MonitorTask:
+    return MonitorTask(
+        task_id="m1", worker_id="W2", slot=slot, slots=slots, standoff_m=4.0, duration_s=duration_s
+    )
+
+
+def last_goto(rig):
+    return [arg for name, arg in rig.autopilot.calls if name == "goto"][-1]
+
+
+def test_holds_the_slot_point_for_the_duration():
+    rig = Rig()
+    rig.agent.offer_plan(plan(monitor(slot=1, slots=4)))
+    rig.run_until(lambda: rig.leaf() == "Monitoring")
+    target = last_goto(rig)
+    angle = 2 * math.pi * 1 / 4
+    assert target.x_m == pytest.approx(W2.x_m + 4 * math.cos(angle))
+    assert target.y_m == pytest.approx(W2.y_m + 4 * math.sin(angle))
+    rig.tick(20)
+    assert rig.mission.head is not None
+    assert rig.agent.status().progress == pytest.approx(2.0 / 3.0, abs=0.05)
+    rig.run_until(lambda: rig.mission.head is None, max_ticks=20)
+    [outcome] = rig.outcomes()
+    assert outcome.result is OutcomeResult.COMPLETED
+
+
+def test_follows_the_worker_when_they_move():
+    rig = Rig()
+    rig.agent.offer_plan(plan(monitor(slot=0, slots=1, duration_s=30.0)))
+    rig.run_until(lambda: rig.leaf() == "Monitoring")
+    moved = point(5.0, 15.0, 3.0)
+    rig.agent.human_pose(
+        HumanPose(worker_id="W2", stamp_s=rig.wall(), position=moved, geo=GeoPoint())
+    )
+    rig.tick(arrive=False)
+    target = last_goto(rig)
+    assert (target.x_m, target.y_m) == pytest.approx((9.0, 15.0))
+
+
+def test_time_monitored_survives_an_interruption():
+    rig = Rig()
+    rig.agent.offer_plan(plan(monitor(duration_s=10.0)))
+    rig.run_until(lambda: rig.leaf() == "Monitoring")
+    rig.tick(30)
+    done = rig.mission.monitored_s("m1")
+    rig.autopilot.update(position=point(20.0, 20.0, 3.0))  # blown away
+    rig.tick(arrive=False)
+    assert rig.leaf() == "Go near Human Target"
+    rig.run_until(lambda: rig.leaf() == "Monitoring")
+    assert rig.mission.monitored_s("m1") >= done
+
+
+def test_stale_poses_are_ignored():
+    rig = Rig()
+    new = HumanPose(worker_id="W2", stamp_s=10.0, position=point(1, 1, 3), geo=GeoPoint())
+    old = HumanPose(worker_id="W2", stamp_s=5.0, position=point(9, 9, 3), geo=GeoPoint())
+    rig.agent.human_pose(new)
+    rig.agent.human_pose(old)
+    assert rig.agent.ctx.surroundings.worker_position("W2") == point(1, 1, 3)
