@@ -2,21 +2,50 @@
 
 from __future__ import annotations
 
+import dataclasses
 from collections.abc import Callable
+
+from msgspec.structs import replace
 
 from ground_station.planner.errors import PlanningProblemError
 from ground_station.planner.export import export
 from ground_station.planner.heuristic import build
 from ground_station.planner.improve import improve
 from ground_station.planner.load import check_problem
-from ground_station.planner.model import Problem
+from ground_station.planner.model import CostWeights, Problem
 from ground_station.planner.result import Plan
 from ground_station.planner.routes import Options
+
+VARIANTS: tuple[tuple[float, float, int], ...] = (
+    (0.5, 0.0, 3),
+    (0.5, 0.3, 6),
+    (1.0, 0.0, 6),
+    (0.5, 1.0, 3),
+    (2.5, 0.3, 6),
+    (1.0, 1.0, 3),
+    (0.5, 0.0, 6),
+    (1.0, 0.3, 3),
+)
+"""(suitability weight factor, resource factor, max evaluations) per variant."""
+RESTART_WORK = 3000
+"""Automatic restarts: ``RESTART_WORK // (actions x UAVs)`` variants (all for
+small instances, none from about 20 UAVs x 150 actions up)."""
 
 
 def score(p: Plan) -> tuple[int, float]:
     """What improvement minimises: (unplaced parts, weighted completion + makespan)."""
     return len(p.unplaced), p.metrics.weighted_completion_s + p.metrics.makespan_s
+
+
+def variants(options: Options, weights: CostWeights) -> list[Options]:
+    """Alternative constructions tried when there is time to improve: the
+    greedy is sensitive to its knobs, so a few differently tuned runs often
+    find a much better start than local search alone."""
+    out = []
+    for w1, rf, me in VARIANTS:
+        w = replace(weights, suitability_s=weights.suitability_s * w1)
+        out.append(dataclasses.replace(options, weights=w, resource_factor=rf, max_eval=me))
+    return out
 
 
 def plan(
@@ -28,11 +57,13 @@ def plan(
     seed: int = 0,
 ) -> Plan:
     """Plan ``problem``: the complete heuristic (or ``options.mode``), then,
-    if ``should_stop`` or ``max_rounds`` is given, bounded improvement.
+    if ``should_stop`` or ``max_rounds`` is given, improvement.
 
-    With improvement, the plain paper heuristic is also run and the better of
-    the two starts the search, and the result is never worse than either.
-    ``should_stop`` is polled between improvement rounds: pass e.g. a
+    Improvement first builds the plain paper heuristic's plan and a few
+    differently tuned constructions (``variants``) while ``should_stop`` stays
+    false, then runs local search (``improve``) from the best of them; the
+    result is never worse than the complete or the paper heuristic's plan.
+    ``should_stop`` is polled between constructions and rounds: pass e.g. a
     deadline check built on the caller's clock. Pure and deterministic for a
     given sequence of ``should_stop`` answers. Raises ``PlanningProblemError``
     for invalid input; what cannot be placed is listed in ``Plan.unplaced``.
@@ -44,13 +75,27 @@ def plan(
     ctx = build(problem, options)
     if should_stop is None and max_rounds <= 0:
         return export(ctx)
+    stop = should_stop or (lambda: False)
     best = export(ctx)
+    floor = best
     if options.mode != "paper":
-        paper_ctx = build(problem, Options(mode="paper", max_split=options.max_split))
-        paper = export(paper_ctx)
-        if score(paper) < score(best):
-            best, ctx = paper, paper_ctx
-            ctx.options = options
-    improve(ctx, should_stop or (lambda: False), max_rounds or 1_000_000_000, seed)
+        others = [Options(mode="paper", max_split=options.max_split)]
+        if max_rounds <= 0:  # time-bounded: also try other tunings
+            count = options.restarts
+            if count is None:  # by size: each costs about one construction
+                work = len(problem.actions) * max(1, len(problem.uavs))
+                count = min(len(VARIANTS), RESTART_WORK // max(1, work))
+            others += variants(options, options.weights or problem.weights)[:count]
+        for i, opt in enumerate(others):
+            if i > 0 and stop():
+                break
+            other_ctx = build(problem, opt)
+            other = export(other_ctx)
+            if i == 0 and score(other) < score(floor):
+                floor = other
+            if score(other) < score(best):
+                best, ctx = other, other_ctx
+        ctx.options = options
+    improve(ctx, stop, max_rounds or 1_000_000_000, seed)
     out = export(ctx)
     return out if score(out) <= score(best) else best

@@ -24,9 +24,6 @@ from ground_station.planner.split import chunk, equal_chunks, fixed_split_count
 
 SPLITS_TRIED = 1
 """How many split counts (best estimates first) are simulated per inspection."""
-RESOURCE_FACTOR = 0.3
-"""Weight of the UAV time an inspection split consumes when choosing how many
-UAVs share it (more UAVs finish sooner but take the fleet from later actions)."""
 
 
 def reachable(ctx: Ctx, kind: str, pos: Vec3, service_s: float) -> bool:
@@ -164,7 +161,7 @@ def place_inspect(ctx: Ctx, a: InspectAction, only: list[int] | None = None) -> 
         for c in splits[m]:
             f, u = _place_chunk(ctx, a, [ok[j] for j in c])
             finish, used = max(finish, f), used + u
-        score = finish + RESOURCE_FACTOR * used + 1e6 * len(ctx.unplaced.get(a.id, ()))
+        score = finish + ctx.options.resource_factor * used + 1e6 * len(ctx.unplaced.get(a.id, ()))
         if best is None or score < best[0]:
             best = (score, ctx.snapshot())
         ctx.restore(snap)
@@ -200,7 +197,7 @@ def _estimate(
             return float("inf")
         taken.add(best[3])
         finish, used = max(finish, best[1]), used + best[2]
-    return finish + RESOURCE_FACTOR * used
+    return finish + ctx.options.resource_factor * used
 
 
 def place_action(ctx: Ctx, a: Action, only: list[int] | None = None) -> None:

@@ -18,10 +18,10 @@ from ground_station.planner.routes import Ctx
 from ground_station.planner.simulate import Sim, State, Task
 
 MIN_GAP_S = 5.0
-MAX_EVAL = 6
 MAX_GAP_EVAL = 2
+"""Idle gaps (before anchored tasks) simulated per part, best bounds first."""
 MAX_ANYWHERE_EVAL = 4
-"""complete mode simulates at most this many candidates (best lower bounds)."""
+"""Mid-route positions simulated per part while improving."""
 
 
 class Choice(NamedTuple):
@@ -114,7 +114,8 @@ def best_insertion(
     reason = "battery_infeasible"
     evaluated = gaps = 0
     for lb, uid, pos in cands:
-        if evaluated >= (MAX_EVAL if best is not None else 3 * MAX_EVAL):
+        max_eval = ctx.options.max_eval
+        if evaluated >= (max_eval if best is not None else 3 * max_eval):
             break
         if best is not None and lb >= best.cost:
             break

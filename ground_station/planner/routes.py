@@ -36,6 +36,15 @@ class Options:
     mode: str = "complete"
     weights: CostWeights | None = None
     max_split: int = 4
+    resource_factor: float = 0.3
+    """Weight of the UAV time an inspection split uses when choosing how many
+    UAVs share it (more finish sooner but take the fleet from later actions)."""
+    max_eval: int = 6
+    """complete mode simulates at most this many insertion candidates per
+    part (best lower bounds first)."""
+    restarts: int | None = None
+    """Differently tuned constructions tried by time-bounded improvement
+    before local search; None chooses by instance size."""
 
 
 class Route:

@@ -11,6 +11,7 @@ from __future__ import annotations
 import argparse
 import sys
 import time
+from collections.abc import Callable
 
 import msgspec
 from rich.console import Console
@@ -39,8 +40,11 @@ def run_mission(
     timeout_s: float,
     shutdown: Shutdown,
     console: Console,
+    on_tick: Callable[[float, list[dict]], None] | None = None,
 ) -> tuple[list[dict], ExecutionRecorder]:
-    """Submit the scripted actions on time and follow them until all end."""
+    """Submit the scripted actions on time and follow them until all end.
+    ``on_tick(mission_s_since_start, records)`` runs every half second (tests
+    inject faults there)."""
     gateway = Gateway(run.url, run.token)
     recorder = ExecutionRecorder()
     pending = sorted(scenario.actions, key=lambda a: a.at_s)
@@ -74,6 +78,8 @@ def run_mission(
                         completed=record["progress"],
                         state=record["state"],
                     )
+            if on_tick is not None:
+                on_tick(elapsed_mission_s, records)
             if not pending and records and all(r["state"] in TERMINAL for r in records):
                 break
             shutdown.wait(0.5)

@@ -51,3 +51,17 @@ def test_should_stop_is_honoured() -> None:
 def test_improvement_is_deterministic() -> None:
     problem = generate(5, 15, 9)
     assert plan(problem, max_rounds=25) == plan(problem, max_rounds=25)
+
+
+def test_time_bounded_improvement_with_restarts_is_valid_and_never_worse() -> None:
+    for seed in (1, 2):
+        problem = generate(5, 20, seed)
+        calls = iter(range(60))
+
+        def stop() -> bool:
+            return next(calls, None) is None  # a deterministic "deadline"
+
+        better = plan(problem, should_stop=stop)
+        assert validate(problem, better) == []
+        assert score(better) <= score(plan(problem))
+        assert score(better) <= score(plan(problem, Options(mode="paper")))
