@@ -14,6 +14,7 @@ COMMANDS: dict[str, tuple[str, str]] = {
     "router": ("ground_station.router:main", "run the ground site's Zenoh router"),
     "ground-station": ("ground_station.main:main", "run the mission manager and planner"),
     "sim": ("sim_fleet.main:main", "run the MAVLink fleet simulator and human tracker"),
+    "agent": ("onboard_agent.main:main", "run one UAV's onboard agent (or: agent tree)"),
     "gateway": ("ground_station.gateway.main:main", "run the operator REST API"),
     "up": ("linecrew.launch.up:main", "run router, ground station, gateway, sim and agents"),
     "demo": ("linecrew.launch.demo:main", "the paper's scenario end to end"),

@@ -11,7 +11,7 @@ ROOT = pathlib.Path(__file__).resolve().parent.parent
 
 def _shell_blocks() -> list[str]:
     text = (ROOT / "README.md").read_text()
-    first_screen = text.split("## What is here")[0]
+    first_screen = "\n## ".join(text.split("\n## ")[:2])  # the intro and "Start here"
     return [b.strip() for b in re.findall(r"```sh\n(.*?)```", first_screen, re.S)]
 
 

@@ -108,6 +108,7 @@ def best_insertion(
                     if nxt.anchor_s is not None and fin + back > nxt.anchor_s:
                         continue
                 lb = costs.complete_cost(w, suit, fin, now, 0.0, jv)
+                lb += w.approach * d0 / kin.speed_mps
             cands.append((lb, uid, pos))
     cands.sort()
     best: Choice | None = None
@@ -142,6 +143,8 @@ def best_insertion(
         else:
             suit, jv = info[uid]
             cost = costs.complete_cost(w, suit, finish, now, delay, jv)
+            st = r.state_before(pos)
+            cost += w.approach * dist(st.pos, start) / r.kin.speed_mps
         if best is None or cost < best.cost:
             best = Choice(cost, uid, pos, tasks, sim, finish, delay)
         if paper:

@@ -144,12 +144,17 @@ class CostWeights(msgspec.Struct, frozen=True, kw_only=True):
     the UAV that is already running the action). Defaults: one unit of
     unsuitability is worth 120 s of delay, so an ideal UAV wins unless an
     acceptable one finishes minutes earlier; continuing a running task is
-    worth 30 s (avoids needless hand-overs on replans).
+    worth 30 s (avoids needless hand-overs on replans). ``approach`` adds,
+    per second of flight from where the UAV is to the part's start, that many
+    seconds: the battery the transit burns must be recharged later (on these
+    fleets about one second of charging per second of flight), which a
+    finish-time J2 alone does not see.
     """
 
     suitability_s: float = 120.0
     travel: float = 1.0
     interruption_s: float = 30.0
+    approach: float = 1.0
 
 
 class Problem(msgspec.Struct, frozen=True, kw_only=True):
