@@ -3,7 +3,7 @@
 Public API (import from here):
 
 - ``Scenario`` and its parts (``scenario``): the site and fleet to simulate;
-  ``paper_scenario()`` builds the paper's small test world.
+  ``scenario_from_proto()`` builds one from a shared ``proto`` site and fleet.
 - ``World``: vehicles, charging stations, tool stations, workers; ``step(dt_s)``
   on an injected clock; fault operations; ``deliveries`` (ground truth).
 - ``Fleet`` / ``FleetConfig`` / ``FleetThread``: the runner that owns the world
@@ -14,9 +14,9 @@ from sim_fleet.autopilot import Command
 from sim_fleet.battery import Battery
 from sim_fleet.events import Outcome, Result, Severity, StatusText
 from sim_fleet.fleet import Fleet, FleetConfig, FleetThread
+from sim_fleet.from_proto import scenario_from_proto
 from sim_fleet.geo import GeoFrame
 from sim_fleet.modes import FlightState, Mode
-from sim_fleet.paper import paper_scenario
 from sim_fleet.scenario import (
     Capability,
     GeoOrigin,
@@ -65,5 +65,5 @@ __all__ = [
     "VehicleType",
     "WorkerSpec",
     "World",
-    "paper_scenario",
+    "scenario_from_proto",
 ]

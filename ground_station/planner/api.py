@@ -16,17 +16,18 @@ from ground_station.planner.model import CostWeights, Problem
 from ground_station.planner.result import Plan
 from ground_station.planner.routes import Options
 
-VARIANTS: tuple[tuple[float, float, int], ...] = (
-    (0.5, 0.0, 3),
-    (0.5, 0.3, 6),
-    (1.0, 0.0, 6),
-    (0.5, 1.0, 3),
-    (2.5, 0.3, 6),
-    (1.0, 1.0, 3),
-    (0.5, 0.0, 6),
-    (1.0, 0.3, 3),
+VARIANTS: tuple[tuple[float, float, int, float], ...] = (
+    (0.5, 0.0, 3, 1.0),
+    (1.0, 0.3, 6, 1.6),
+    (0.5, 0.3, 6, 0.4),
+    (1.0, 0.0, 6, 1.0),
+    (0.5, 1.0, 3, 1.6),
+    (2.5, 0.3, 6, 1.0),
+    (1.0, 1.0, 3, 0.4),
+    (0.5, 0.0, 6, 1.6),
 )
-"""(suitability weight factor, resource factor, max evaluations) per variant."""
+"""Per variant: factors on the suitability and approach weights, the
+resource factor and max evaluations."""
 RESTART_WORK = 3000
 """Automatic restarts: ``RESTART_WORK // (actions x UAVs)`` variants (all for
 small instances, none from about 20 UAVs x 150 actions up)."""
@@ -42,8 +43,10 @@ def variants(options: Options, weights: CostWeights) -> list[Options]:
     greedy is sensitive to its knobs, so a few differently tuned runs often
     find a much better start than local search alone."""
     out = []
-    for w1, rf, me in VARIANTS:
-        w = replace(weights, suitability_s=weights.suitability_s * w1)
+    for w1, rf, me, wa in VARIANTS:
+        w = replace(
+            weights, suitability_s=weights.suitability_s * w1, approach=weights.approach * wa
+        )
         out.append(dataclasses.replace(options, weights=w, resource_factor=rf, max_eval=me))
     return out
 

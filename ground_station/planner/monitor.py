@@ -22,6 +22,8 @@ from ground_station.planner.simulate import Task, monitor_reach
 
 MAX_T0_CANDIDATES = 2
 MAX_REACH = 5
+MON_TRAVEL = 1.0
+"""Rank cost per second of flight to a slot (3 and 6 were worse on the bench)."""
 PUSH_PENALTY_S = 600.0
 """Extra rank cost of a repair segment that delays a UAV's later tasks."""
 """UAVs (best first by suitability and distance) examined for each segment."""
@@ -92,7 +94,15 @@ def _cover_needs(
             jv = costs.j3(ctx.running.get(uid), a.id)
             penalty = 0.0 if p == len(r.tasks) else PUSH_PENALTY_S
             pre.append(
-                (w.suitability_s * suit + w.interruption_s * jv + travel_s + penalty, uid, suit, p)
+                (
+                    w.suitability_s * suit
+                    + w.interruption_s * jv
+                    + MON_TRAVEL * travel_s
+                    + penalty,
+                    uid,
+                    suit,
+                    p,
+                )
             )
         pre.sort()
         ranked = []

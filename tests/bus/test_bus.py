@@ -24,7 +24,7 @@ from proto import (
     Role,
     Unavailable,
 )
-from tests.support.processes import free_port, running, wait_until
+from tests.support.processes import free_port, running_alive, wait_until
 
 KEYS = KeySpace()
 
@@ -42,10 +42,9 @@ def two_buses(bus_config):
 @pytest.fixture
 def peer(router):
     args = [sys.executable, "-m", "tests.support.peer", "--connect", router, "--name", "p1"]
-    with Bus.open(BusConfig(connect=(router,))) as watcher:
-        token = KEYS.alive(Role.SIM, "p1")
-        with running(args, "peer", lambda: token in watcher.alive(token)) as proc:
-            yield proc
+    token = KEYS.alive(Role.SIM, "p1")
+    with running_alive(args, "peer", BusConfig(connect=(router,)), token) as proc:
+        yield proc
 
 
 def test_typed_publish_reaches_a_typed_subscriber(two_buses):

@@ -16,8 +16,8 @@ from proto.plan import Plan
 from proto.site import BatterySwap
 from proto.telemetry import AgentStatus, TaskOutcome
 from sim_fleet import Fleet, FleetConfig, FleetThread
+from sim_fleet.from_proto import scenario_from_proto
 from sim_fleet.vehicle import AutopilotParams
-from tests.onboard_agent.simworld import sim_scenario, write_json
 from tests.support.processes import running, wait_until
 
 SPEEDUP = 10.0
@@ -89,7 +89,8 @@ def fleet():
     config = FleetConfig(
         speedup=SPEEDUP, rate_hz=50.0, base_port=0, params=AutopilotParams(auto_disarm_s=30.0)
     )
-    runner = FleetThread(Fleet(sim_scenario(fast_scenario()), config)).start()
+    scenario = fast_scenario()
+    runner = FleetThread(Fleet(scenario_from_proto(scenario.site, scenario.fleet), config)).start()
     try:
         yield runner
     finally:
@@ -113,7 +114,8 @@ def pytest_runtest_makereport(item, call):
 @pytest.fixture
 def agent(request, router, fleet, gs, tmp_path):
     """``python -m onboard_agent`` flying uav-1 of the fleet."""
-    path = write_json(fast_scenario(), tmp_path / "scenario.json")
+    path = tmp_path / "scenario.json"
+    path.write_bytes(msgspec.json.encode(fast_scenario()))
     args = [
         sys.executable,
         "-m",

@@ -6,13 +6,14 @@ import socket
 
 import pytest
 
-from sim_fleet import Fleet, FleetConfig, FleetThread, paper_scenario
+from sim_fleet import Fleet, FleetConfig, FleetThread
 from sim_fleet.modes import Mode
 from tests.sim_fleet.helpers import command
+from tests.sim_fleet.small_world import small_world
 
 
 def test_tick_advances_simulated_time_by_speedup():
-    fleet = Fleet(paper_scenario(1), FleetConfig(speedup=8.0))
+    fleet = Fleet(small_world(1), FleetConfig(speedup=8.0))
     fleet.tick(0.25)
     assert fleet.world.time_s == pytest.approx(2.0)
 
@@ -21,7 +22,7 @@ def test_speedup_scales_motion_energy_and_charging_alike():
     """The same wall time at K=1 and K=10 differs only by K in every quantity."""
     results = []
     for k in (1.0, 10.0):
-        fleet = Fleet(paper_scenario(2), FleetConfig(speedup=k))
+        fleet = Fleet(small_world(2), FleetConfig(speedup=k))
         w = fleet.world
         v = w.vehicle("uav1")
         command(w, v, 176, 1, Mode.GUIDED)
@@ -41,7 +42,7 @@ def test_thread_runner_binds_consecutive_ports_and_stops_cleanly():
     # the port after a free one is very likely free too; retry once if not
     cfg = FleetConfig(base_port=base, speedup=1.0)
     try:
-        runner = FleetThread(Fleet(paper_scenario(3), cfg)).start()
+        runner = FleetThread(Fleet(small_world(3), cfg)).start()
     except OSError:
         pytest.skip("consecutive ports not free")
     ports = runner.fleet.ports
@@ -58,8 +59,8 @@ def test_port_in_use_fails_start():
         s.bind(("127.0.0.1", 0))
         taken = s.getsockname()[1]
         with pytest.raises(OSError):
-            FleetThread(Fleet(paper_scenario(1), FleetConfig(base_port=taken))).start()
+            FleetThread(Fleet(small_world(1), FleetConfig(base_port=taken))).start()
 
 
 def test_stop_before_start_is_harmless():
-    Fleet(paper_scenario(1)).stop()
+    Fleet(small_world(1)).stop()

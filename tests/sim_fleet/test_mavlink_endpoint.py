@@ -6,10 +6,11 @@ import socket
 
 import pytest
 
-from sim_fleet import Fleet, FleetConfig, FleetThread, paper_scenario
+from sim_fleet import Fleet, FleetConfig, FleetThread
 from sim_fleet.modes import Mode
 from sim_fleet.vehicle import AutopilotParams
 from tests.sim_fleet.mavclient import Client, mavlink
+from tests.sim_fleet.small_world import small_world
 
 SPEEDUP = 20.0
 ACCEPTED = mavlink.MAV_RESULT_ACCEPTED
@@ -20,7 +21,7 @@ def fleet():
     cfg = FleetConfig(
         speedup=SPEEDUP, rate_hz=50.0, base_port=0, params=AutopilotParams(auto_disarm_s=30.0)
     )
-    runner = FleetThread(Fleet(paper_scenario(2), cfg)).start()
+    runner = FleetThread(Fleet(small_world(2), cfg)).start()
     try:
         yield runner
     finally:
@@ -226,7 +227,7 @@ def test_static_peer_gets_telemetry_without_speaking_first():
 
     listener = mavutil.mavlink_connection(f"udpin:127.0.0.1:{peer_port}")
     cfg = FleetConfig(speedup=SPEEDUP, base_port=0, static_peers=(("127.0.0.1", peer_port),))
-    runner = FleetThread(Fleet(paper_scenario(1), cfg)).start()
+    runner = FleetThread(Fleet(small_world(1), cfg)).start()
     try:
         hb = listener.recv_match(type="HEARTBEAT", blocking=True, timeout=10)
         assert hb is not None and hb.get_srcSystem() == 1

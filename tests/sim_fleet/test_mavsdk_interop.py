@@ -9,7 +9,8 @@ import asyncio
 
 import pytest
 
-from sim_fleet import Fleet, FleetConfig, FleetThread, paper_scenario
+from sim_fleet import Fleet, FleetConfig, FleetThread
+from tests.sim_fleet.small_world import small_world
 
 mavsdk = pytest.importorskip("mavsdk")
 from mavsdk.asyncio.mavsdk import Mavsdk  # noqa: E402
@@ -50,7 +51,7 @@ async def fly(port: int) -> dict:
 
 def test_mavsdk_discovers_reads_arms_takes_off_and_lands():
     cfg = FleetConfig(base_port=0, speedup=10.0, rate_hz=50.0)
-    runner = FleetThread(Fleet(paper_scenario(1), cfg)).start()
+    runner = FleetThread(Fleet(small_world(1), cfg)).start()
     try:
         seen = asyncio.run(asyncio.wait_for(fly(runner.fleet.ports["uav1"]), 60.0))
     finally:

@@ -11,9 +11,18 @@ import tempfile
 import time
 from collections.abc import Callable, Iterator
 
+from linecrew.bus import Bus, BusConfig
 from linecrew.bus.router_process import free_port, port_open
 
-__all__ = ["Process", "free_port", "port_open", "router_args", "running", "wait_until"]
+__all__ = [
+    "Process",
+    "free_port",
+    "port_open",
+    "router_args",
+    "running",
+    "running_alive",
+    "wait_until",
+]
 
 
 def wait_until(predicate: Callable[[], object], timeout_s: float = 10.0, what: str = "") -> None:
@@ -78,6 +87,18 @@ def running(args: list[str], name: str, ready: Callable[[], object]) -> Iterator
         raise
     finally:
         proc.stop()
+
+
+@contextlib.contextmanager
+def running_alive(
+    args: list[str], name: str, bus_config: BusConfig, token_key: str
+) -> Iterator[Process]:
+    """:func:`running`, ready once the process's liveliness ``token_key`` is seen."""
+    with (
+        Bus.open(bus_config) as watcher,
+        running(args, name, lambda: token_key in watcher.alive(token_key)) as proc,
+    ):
+        yield proc
 
 
 def router_args(port: int, *extra: str) -> list[str]:

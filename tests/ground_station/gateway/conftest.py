@@ -7,9 +7,8 @@ import sys
 import httpx
 import pytest
 
-from linecrew.bus import Bus
 from proto import KeySpace, Role
-from tests.support.processes import free_port, running
+from tests.support.processes import free_port, running, running_alive
 
 TOKEN = "test-token-123"
 KEYS = KeySpace()
@@ -26,10 +25,9 @@ def gs(router, bus_config, tmp_path):
         "--db",
         str(tmp_path / "gs.db"),
     ]
-    with Bus.open(bus_config) as watcher:
-        token = KEYS.alive(Role.GROUND_STATION, "gs")
-        with running(args, "gs", lambda: token in watcher.alive(token)) as proc:
-            yield proc
+    token = KEYS.alive(Role.GROUND_STATION, "gs")
+    with running_alive(args, "gs", bus_config, token) as proc:
+        yield proc
 
 
 @pytest.fixture

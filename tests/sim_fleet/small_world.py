@@ -1,4 +1,5 @@
-"""The small test world of the paper (Calvo et al., ICUAS 2022) as a Scenario.
+"""A small world for simulator tests, shaped after the paper's (Calvo et al.,
+ICUAS 2022); the paper scenario linecrew ships is ``linecrew.scenarios.load("paper")``.
 
 Positions are the paper's; figures it left arbitrary are chosen here to be
 plausible for small multirotors: a 60 Wh pack drawing ~250 W gives ~14 min of
@@ -85,7 +86,7 @@ WORKERS = (
 _ROLES = ("physical", "inspection", "safety", "safety", "safety")
 
 
-def paper_scenario(n_uavs: int = 3) -> Scenario:
+def small_world(n_uavs: int = 3) -> Scenario:
     """UAV-1 physical (gripper), UAV-2 inspection, UAV-3.. safety; UAV-n on Cn."""
     if not 1 <= n_uavs <= 5:
         raise ValueError("the paper's world has room for 1 to 5 UAVs")
