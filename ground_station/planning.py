@@ -5,7 +5,7 @@ per-UAV wire ``Task`` lists out.
 Planner time is relative: the problem's ``now_s`` is 0 and a step's times
 are seconds from now; wire tasks carry absolute mission seconds.
 Task ids are derived from what a task is (``{action}.wp{i}-{j}``,
-``{action}.slot{s}``, ``{uav}.recharge{n}`` ...) so that a replan that
+``{action}.slot{s}.{uav}.{n}``, ``{uav}.recharge{n}`` ...) so that a replan that
 leaves a UAV's work alone yields the same ids, and an agent keeps flying.
 """
 
@@ -220,7 +220,8 @@ def _simple_task(
     match step.kind:
         case "monitor":
             return MonitorTask(
-                task_id=f"{step.action_id}.slot{step.index}.{ordinal(f'm{step.action_id}')}",
+                task_id=f"{step.action_id}.slot{step.index}.{uav_id}."
+                f"{ordinal('monitor:' + step.action_id)}",
                 action_id=step.action_id,
                 worker_id=action.worker_id,
                 slot=step.index,

@@ -18,6 +18,7 @@ COMMANDS: dict[str, tuple[str, str]] = {
     "gateway": ("ground_station.gateway.main:main", "run the operator REST API"),
     "up": ("linecrew.launch.up:main", "run router, ground station, gateway, sim and agents"),
     "demo": ("linecrew.launch.demo:main", "the paper's scenario end to end"),
+    "chaos": ("linecrew.chaos.main:main", "seeded partitions, kills, faults on a local fleet"),
     "submit": ("linecrew.client.commands:submit_main", "submit inspect / monitor / deliver"),
     "gesture": ("linecrew.client.commands:gesture_main", "submit a crew gesture"),
     "actions": ("linecrew.client.commands:actions_main", "list actions"),

@@ -63,6 +63,7 @@ class Comms:
                 log.info("ground station %s %s", token, "up" if alive else "gone")
                 self.agent.ground_station(token, alive)
                 if alive:
+                    self.agent.mission.redeliver()
                     task = asyncio.create_task(self.resync())
                     self._resyncs.add(task)
                     task.add_done_callback(self._resyncs.discard)

@@ -41,6 +41,7 @@ class Mission:
         self.epoch = 0
         self.tasks: collections.deque[Task] = collections.deque()
         self.outbox: list[TaskOutcome] = []
+        self._sent: collections.deque[TaskOutcome] = collections.deque(maxlen=16)
         self._waypoints_done: dict[str, list[int]] = {}
         self._monitored_s: dict[str, float] = {}
         self._failures: dict[str, int] = {}
@@ -141,7 +142,16 @@ class Mission:
     def take_outcomes(self) -> list[TaskOutcome]:
         """The outcomes not yet delivered; the outbox is emptied."""
         outcomes, self.outbox = self.outbox, []
+        self._sent.extend(outcomes)
         return outcomes
+
+    def redeliver(self) -> None:
+        """Queue the recently sent outcomes again: after the ground station's
+        token returns, some may have been published into a session the router
+        had already dropped. The ground station records duplicates as stale."""
+        pending = {o.task_id for o in self.outbox}
+        self.outbox[:0] = [o for o in self._sent if o.task_id not in pending]
+        self._sent.clear()
 
     def _pop(self, task: Task) -> None:
         if self.tasks and self.tasks[0].task_id == task.task_id:

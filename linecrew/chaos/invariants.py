@@ -20,6 +20,7 @@ from __future__ import annotations
 
 import collections
 import dataclasses
+import itertools
 from typing import Any
 
 from proto import SimState
@@ -131,7 +132,7 @@ class Checker:
                 self._violate(at_s, "double_task", f"{key} planned for {sorted(uavs)}")
         for slot, segments in sorted(slots.items()):
             segments.sort()
-            for (s1, e1, u1), (s2, e2, u2) in zip(segments, segments[1:], strict=False):
+            for (s1, e1, u1), (s2, e2, u2) in itertools.pairwise(segments):
                 overlap = min(e1, e2) - max(s1, s2)
                 if u1 != u2 and overlap > HANDOVER_S:
                     self._violate(

@@ -93,3 +93,17 @@ def test_abandon_fails_every_task_with_progress():
     assert outcomes[0].waypoints_done == [0]
     assert outcomes[0].progress == 1 / 3
     assert m.head is None
+
+
+def test_recently_sent_outcomes_are_queued_again_after_each_reconnect():
+    m = mission()
+    m.offer(plan(inspect_task("a"), inspect_task("b")))
+    m.abandon("emergency: test")
+    sent = m.take_outcomes()
+    assert m.take_outcomes() == []
+    m.redeliver()  # the ground station's token came back: they may have been lost
+    assert m.take_outcomes() == sent
+    m.redeliver()
+    assert [o.task_id for o in m.take_outcomes()] == [o.task_id for o in sent]
+    m.take_outcomes()
+    assert m.take_outcomes() == []
