@@ -24,6 +24,12 @@ def j3(running_action: str | None, action_id: str) -> float:
     return -1.0 if running_action == action_id else 0.0
 
 
+def j3_interrupt(running_weight: float, new_weight: float) -> float:
+    """Interruption term for displacing a running task: 1 plus the running
+    action's weight relative to the new one (higher priority costs more)."""
+    return 1.0 + running_weight / new_weight
+
+
 def complete_cost(
     w: CostWeights, suit: float, finish_s: float, now_s: float, delay_s: float, j3_value: float
 ) -> float:

@@ -4,8 +4,8 @@ Each round removes one to three related actions (a seed action and actions
 scheduled next to it on the same UAVs) and re-inserts them in queue order
 with the heuristic's cheapest insertion, now allowed between any two actions
 of a route. A round is kept only if the objective strictly improves:
-first fewer unplaced parts, then a smaller weighted completion time plus
-makespan (seconds). The caller bounds the time: ``should_stop`` is polled
+first fewer unplaced parts, then a smaller weight-averaged completion time
+plus makespan (seconds). The caller bounds the time: ``should_stop`` is polled
 between rounds (the library reads no clock) and ``max_rounds`` caps work.
 Deterministic for a given ``seed`` and sequence of ``should_stop`` answers.
 """
@@ -27,7 +27,7 @@ RESTART_AFTER = 60
 
 
 def objective(ctx: Ctx) -> tuple[int, float]:
-    """(unplaced parts, weighted completion + makespan) of the current state.
+    """(unplaced parts, weight-averaged completion + makespan) of the state.
 
     Home legs are left out (they follow from the last tasks); ``export``
     computes the exact metrics.
@@ -49,7 +49,8 @@ def objective(ctx: Ctx) -> tuple[int, float]:
     for aid, c in comp.items():
         if aid not in ctx.unplaced:
             weighted += ctx.actions[aid].weight * (c - now)
-    return failed, weighted + makespan - now
+    total = sum(a.weight for a in ctx.problem.actions) or 1.0
+    return failed, weighted / total + makespan - now
 
 
 def _related(ctx: Ctx, seed: str, rng: random.Random, size: int) -> list[str]:

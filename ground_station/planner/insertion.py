@@ -32,6 +32,18 @@ class Choice(NamedTuple):
     sim: Sim
     finish_s: float
     delay_s: float
+    preempt: bool = False
+
+
+def preemption(ctx: Ctx, uid: str, action_id: str) -> float | None:
+    """J3 of interrupting ``uid``'s running task for ``action_id``; None if
+    it has none or the new action does not have a strictly higher weight."""
+    r = ctx.routes[uid]
+    if not r.tasks or (r.tasks[0].action_id, r.tasks[0].index) not in ctx.pinned:
+        return None
+    running = ctx.actions[r.tasks[0].action_id].weight
+    new = ctx.actions[action_id].weight
+    return costs.j3_interrupt(running, new) if new > running else None
 
 
 def gap_positions(ctx: Ctx, uid: str) -> list[int]:
@@ -92,7 +104,15 @@ def best_insertion(
         info[uid] = (suit, jv)
         n = len(r.tasks)
         positions = (n,) if paper else (n, *gap_positions(ctx, uid))
+        interrupt = None if paper or not ctx.pinned else preemption(ctx, uid, action_id)
+        if interrupt is not None:
+            positions = (*positions, -1)  # -1: before the running task
         for pos in positions:
+            if pos < 0:
+                fin = max(r.init.t + dist(r.init.pos, start) / kin.speed_mps, release_s) + part_s
+                lb = costs.complete_cost(w, suit, fin, now, 0.0, jv + interrupt)
+                cands.append((lb, uid, pos))
+                continue
             st = r.states[pos - 1] if pos > 0 else r.init
             if paper:
                 lb = costs.paper_cost(w, suit, st, start, jv)
@@ -121,14 +141,16 @@ def best_insertion(
         if best is not None and lb >= best.cost:
             break
         r = ctx.routes[uid]
+        preempt = pos < 0
         if pos < len(r.tasks):
             if gaps >= (MAX_ANYWHERE_EVAL if ctx.anywhere else MAX_GAP_EVAL):
                 continue
             gaps += 1
         else:
             evaluated += 1
+        pos = max(pos, 0)
         tasks = make(r.state_before(pos))
-        sim = ctx.try_insert(uid, pos, tasks)
+        sim = ctx.try_preempt(uid, tasks) if preempt else ctx.try_insert(uid, pos, tasks)
         if isinstance(sim, str):
             if sim == "late":
                 reason = "battery_infeasible"
@@ -142,15 +164,20 @@ def best_insertion(
             cost = lb
         else:
             suit, jv = info[uid]
+            if preempt:
+                jv += preemption(ctx, uid, action_id) or 0.0
             cost = costs.complete_cost(w, suit, finish, now, delay, jv)
             st = r.state_before(pos)
             cost += w.approach * dist(st.pos, start) / r.kin.speed_mps
         if best is None or cost < best.cost:
-            best = Choice(cost, uid, pos, tasks, sim, finish, delay)
+            best = Choice(cost, uid, pos, tasks, sim, finish, delay, preempt)
         if paper:
             break
     return best, reason
 
 
 def apply(ctx: Ctx, choice: Choice) -> None:
-    ctx.commit(choice.uid, choice.pos, choice.tasks, choice.sim)
+    if choice.preempt:
+        ctx.commit_preempt(choice.uid, choice.tasks, choice.sim)
+    else:
+        ctx.commit(choice.uid, choice.pos, choice.tasks, choice.sim)

@@ -143,6 +143,8 @@ def check_problem(p: Problem) -> None:
         act = actions.get(u.running.action_id)
         if act is None:
             raise PlanningProblemError(f"$.uavs[{i}].running.action_id", "unknown action")
+        if act.release_s > p.now_s:
+            raise PlanningProblemError(f"$.uavs[{i}].running.action_id", "action not released yet")
         if isinstance(act, InspectAction) and not 0 <= u.running.index < len(act.waypoints):
             raise PlanningProblemError(f"$.uavs[{i}].running.index", "waypoint out of range")
         if isinstance(act, DeliverAction) and u.tool != act.tool:

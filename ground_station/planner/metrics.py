@@ -60,4 +60,5 @@ def compute_metrics(problem: Problem, plan: Plan, planning_time_s: float = 0.0) 
         weighted_completion_s=weighted,
         unplaced_parts=len(plan.unplaced),
         planning_time_s=planning_time_s,
+        mean_completion_s=weighted / max(1e-9, sum(a.weight for a in problem.actions)),
     )

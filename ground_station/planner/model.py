@@ -149,8 +149,8 @@ class CostWeights(msgspec.Struct, frozen=True, kw_only=True):
     seconds: the battery a transit burns must be recharged later (about 1.4 s
     on a pad per second of flight for the bench fleets) and pads are scarce,
     which a finish-time J2 alone does not see. 5 was the best of 0/2/3/5/8
-    on the corridor bench (-3 % to -16 % weighted completion + makespan
-    against 0); the paper's distance-only J2 is the other extreme.
+    on the corridor bench (1 % to 14 % better makespan + mean completion
+    than 0); the paper's distance-only J2 is the other extreme.
     """
 
     suitability_s: float = 120.0

@@ -21,7 +21,7 @@ from ground_station.planner.routes import Ctx
 from ground_station.planner.simulate import Task, monitor_reach
 
 MAX_T0_CANDIDATES = 2
-MAX_REACH = 5
+MAX_REACH = 3
 MON_TRAVEL = 1.0
 """Rank cost per second of flight to a slot (3 and 6 were worse on the bench)."""
 PUSH_PENALTY_S = 600.0

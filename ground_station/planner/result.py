@@ -67,7 +67,8 @@ class Metrics(msgspec.Struct, frozen=True, kw_only=True):
 
     ``makespan_s`` is from ``now_s`` to the end of the last step (all UAVs
     landed); ``weighted_completion_s`` sums weight x (completion - now_s)
-    over fully placed actions. ``planning_time_s`` is filled by callers
+    over fully placed actions and ``mean_completion_s`` divides it by the
+    total weight of all actions. ``planning_time_s`` is filled by callers
     that time the planner (the library reads no clock).
     """
 
@@ -78,6 +79,7 @@ class Metrics(msgspec.Struct, frozen=True, kw_only=True):
     weighted_completion_s: float = 0.0
     unplaced_parts: int = 0
     planning_time_s: float = 0.0
+    mean_completion_s: float = 0.0
 
 
 class Plan(msgspec.Struct, frozen=True, kw_only=True):

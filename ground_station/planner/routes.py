@@ -113,6 +113,25 @@ class Ctx:
         old_map = [-1] * len(new) + list(range(pos, len(r.tasks)))
         return simulate(r.kin, self.site, self.pads, st, tasks, (uid, st.t), r.states, old_map)
 
+    def _resumed(self, uid: str) -> list[Task]:
+        """The route with its running first task turned into a normal one (a
+        task that is interrupted is redone in full when resumed)."""
+        r = self.routes[uid]
+        return [r.tasks[0].resumed(), *r.tasks[1:]]
+
+    def try_preempt(self, uid: str, new: list[Task]) -> Sim | str:
+        """Simulate ``new`` before the UAV's running task (J3 interruption)."""
+        r = self.routes[uid]
+        tasks = new + self._resumed(uid)
+        old_map = [-1] * (len(new) + 1) + list(range(1, len(r.tasks)))
+        return simulate(
+            r.kin, self.site, self.pads, r.init, tasks, (uid, r.init.t), r.states, old_map
+        )
+
+    def commit_preempt(self, uid: str, new: list[Task], sim: Sim) -> None:
+        """Apply ``try_preempt``; the interrupted task stays pinned to this UAV."""
+        self._replace_suffix(uid, 0, new + self._resumed(uid), sim)
+
     def commit(self, uid: str, pos: int, new: list[Task], sim: Sim) -> None:
         """Apply a successful ``try_insert``."""
         r = self.routes[uid]
@@ -280,10 +299,12 @@ def new_ctx(problem: Problem, options: Options) -> Ctx:
         if isinstance(act, InspectAction):
             wp = act.waypoints[run.index]
             task = Task("inspect", act.id, run.index, wp.position_m, run.remaining_s)
+            task.full_s = wp.service_s
         elif isinstance(act, DeliverAction):
             task = Task(
                 "deliver", act.id, None, act.worker_m, run.remaining_s or act.drop_s, tool=act.tool
             )
+            task.full_s = act.drop_s
         if task is not None:
             sim = ctx.try_insert(u.id, 0, [task])
             if not isinstance(sim, str):

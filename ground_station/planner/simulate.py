@@ -67,10 +67,13 @@ def advance(
     e_end = _service_end_e(k, e_at, task.service_s)
     direct_ok = e_end - ret_e >= k.reserve_wh - EPS_WH and e_wait >= k.reserve_wh - EPS_WH
     rc = None
+    service = task.service_s
     if not direct_ok or (wait > LONG_WAIT_S and not landed) or (task.topup and not landed):
         rc = recharge_option(k, site, pads, st, task.pos, task.release_s, anchor, ign, soft=soft)
         if rc is not None:
-            e_end_rc = _service_end_e(k, rc.e_at_task, task.service_s)
+            if task.full_s is not None:  # a running task redone in full after recharging
+                service = task.full_s
+            e_end_rc = _service_end_e(k, rc.e_at_task, service)
             short = e_end_rc - ret_e < k.reserve_wh - EPS_WH
             later = direct_ok and anchor is None and rc.arrive_task > arr + EPS_S
             if short or (later and not task.topup):
@@ -86,7 +89,7 @@ def advance(
             if hop is None:
                 return "battery"
             st = emit_recharge(k, site, st, hop, steps, res)
-            return advance(k, site, pads, st, task, steps, res, ign, depth + 1, soft)
+            return advance(k, site, pads, st, task.resumed(), steps, res, ign, depth + 1, soft)
     if rc is not None:
         st = emit_recharge(k, site, st, rc, steps, res)
         arr = rc.arrive_task
@@ -95,11 +98,13 @@ def advance(
         wait = arr - tr - st.t
         e_wait = st.e
         e_at = rc.e_at_task
-        e_end = _service_end_e(k, e_at, task.service_s)
+        e_end = _service_end_e(k, e_at, service)
         t, pos = st.t, st.pos
+    else:
+        service = task.service_s
     if wait > EPS_S:
         steps.append(("wait", t, t, t + wait, e_wait, pos, None, None, None, None, 0.0))
-    end = arr + task.service_s
+    end = arr + service
     steps.append(
         (
             task.kind,

@@ -13,6 +13,7 @@ class Task:
     __slots__ = (
         "action_id",
         "anchor_s",
+        "full_s",
         "index",
         "kind",
         "pos",
@@ -42,6 +43,7 @@ class Task:
         self.anchor_s = anchor_s
         self.tool = tool
         self.topup = False  # recharge before this task if at all possible
+        self.full_s: float | None = None  # a running task's full service, if resumed later
 
     def copy_topup(self) -> Task:
         t = Task(
@@ -55,7 +57,23 @@ class Task:
             self.tool,
         )
         t.topup = True
+        t.full_s = self.full_s
         return t
+
+    def resumed(self) -> Task:
+        """This running task redone in full (after a recharge or interruption)."""
+        if self.full_s is None:
+            return self
+        return Task(
+            self.kind,
+            self.action_id,
+            self.index,
+            self.pos,
+            self.full_s,
+            self.release_s,
+            self.anchor_s,
+            self.tool,
+        )
 
     def __repr__(self) -> str:
         return f"Task({self.kind},{self.action_id},{self.index},{self.anchor_s})"

@@ -79,6 +79,9 @@ def validate(problem: Problem, plan: Plan) -> list[Violation]:
             not u.airborne,
             u.tool,
         )
+        # A running task is continued (its remaining time suffices) only if it is
+        # the UAV's first service, before any recharge; otherwise it is redone.
+        fresh = True
         for n, s in enumerate(up.steps):
             where = f"step {n} ({s.kind})"
             if abs(s.start_s - time) > TOL_S:
@@ -104,7 +107,18 @@ def validate(problem: Problem, plan: Plan) -> list[Violation]:
             if emergency and s.kind in SERVICE_KIND:
                 rep.add("below_reserve", f"{where}: works before recovering from low battery", uid)
             if s.kind in SERVICE_KIND:
-                _check_action_step(rep, problem, u.id, t.capabilities, s, act, where)
+                drop_s = None  # a running delivery may finish with its remaining drop time
+                run = u.running
+                if (
+                    s.kind == "deliver"
+                    and run is not None
+                    and run.action_id == s.action_id
+                    and fresh
+                ):
+                    drop_s = (
+                        min(run.remaining_s, act.drop_s) if isinstance(act, DeliverAction) else None
+                    )
+                _check_action_step(rep, problem, u.id, t.capabilities, s, act, where, drop_s)
                 if s.kind == "pick":
                     if tool is not None:
                         rep.add("pick_with_tool", f"{where}: already holds {tool!r}", uid)
@@ -128,8 +142,9 @@ def validate(problem: Problem, plan: Plan) -> list[Violation]:
                     need = None
                     if isinstance(act, InspectAction) and 0 <= s.index < len(act.waypoints):
                         need = act.waypoints[s.index].service_s
-                        if n == 0 and run and (run.action_id, run.index) == (act.id, s.index):
-                            need = run.remaining_s
+                        same = run is not None and (run.action_id, run.index) == (act.id, s.index)
+                        if same and fresh:  # continuing the running task
+                            need = min(need, run.remaining_s)
                     if need is not None and serve < need - TOL_S:
                         rep.add("service_too_short", f"{where}: {serve:.2f} s < {need} s", uid)
                 elif s.kind == "monitor" and s.action_id is not None and s.index is not None:
@@ -140,6 +155,7 @@ def validate(problem: Problem, plan: Plan) -> list[Violation]:
                 if not landed:
                     e -= t.hover_power_w * serve / 3600.0
             elif s.kind == "recharge":
+                fresh = False
                 st = stations.get(s.station or "")
                 if st is None or st.pads < 1 or dist(st.position_m, s.position_m) > TOL_M:
                     rep.add("recharge_station", f"{where}: not a charging station", uid)
@@ -169,6 +185,8 @@ def validate(problem: Problem, plan: Plan) -> list[Violation]:
             if e < floor - TOL_WH:
                 rep.add("below_reserve", f"{where}: {e:.2f} Wh", uid)
             pos, time = s.position_m, s.end_s
+            if s.kind in SERVICE_KIND:
+                fresh = False
             if s.kind in ("recharge", "home") and emergency:
                 emergency, floor = False, normal_floor
     _check_pads(rep, stations, pad_use)
@@ -176,7 +194,7 @@ def validate(problem: Problem, plan: Plan) -> list[Violation]:
     return rep.items
 
 
-def _check_action_step(rep, problem, uid, caps, s, act, where) -> None:  # type: ignore[no-untyped-def]
+def _check_action_step(rep, problem, uid, caps, s, act, where, drop_s=None) -> None:  # type: ignore[no-untyped-def]
     kind = SERVICE_KIND[s.kind]
     if kind not in caps:
         rep.add("capability", f"{where}: UAV type cannot {kind}", uid, s.action_id)
@@ -201,7 +219,7 @@ def _check_action_step(rep, problem, uid, caps, s, act, where) -> None:  # type:
         if s.kind == "deliver":
             if dist(act.worker_m, s.position_m) > TOL_M:
                 rep.add("wrong_position", f"{where}: not at the worker", uid, act.id)
-            if s.end_s - s.arrive_s < act.drop_s - TOL_S:
+            if s.end_s - s.arrive_s < (act.drop_s if drop_s is None else drop_s) - TOL_S:
                 rep.add("service_too_short", f"{where}: drop too short", uid, act.id)
         elif s.end_s - s.arrive_s < act.pick_s - TOL_S:
             rep.add("service_too_short", f"{where}: pick too short", uid, act.id)

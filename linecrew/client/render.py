@@ -7,15 +7,7 @@ from typing import Any
 from rich.table import Table
 from rich.text import Text
 
-GLYPH = {
-    "inspect": ("I", "green"),
-    "monitor": ("M", "blue"),
-    "pick": ("P", "magenta"),
-    "deliver": ("D", "red"),
-    "recharge": ("R", "yellow"),
-    "wait": ("w", "bright_black"),
-    "home": ("H", "cyan"),
-}
+from ground_station.planner.gantt import GLYPH
 
 
 def actions_table(records: list[dict[str, Any]]) -> Table:

@@ -58,7 +58,7 @@ def test_time_bounded_improvement_with_restarts_is_valid_and_never_worse() -> No
         problem = generate(5, 20, seed)
         calls = iter(range(60))
 
-        def stop() -> bool:
+        def stop(calls=calls) -> bool:
             return next(calls, None) is None  # a deterministic "deadline"
 
         better = plan(problem, should_stop=stop)

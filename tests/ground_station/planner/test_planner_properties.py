@@ -3,6 +3,7 @@ reason, and planning is deterministic."""
 
 from __future__ import annotations
 
+import msgspec
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
@@ -13,6 +14,7 @@ from ground_station.planner import (
     Options,
     Plan,
     Problem,
+    RunningTask,
     Station,
     ToolStation,
     Uav,
@@ -145,3 +147,29 @@ def test_corridor_instances_validate(n_uavs, n_actions, seed, mode) -> None:
     p = plan(problem, Options(mode=mode))
     assert validate(problem, p) == []
     accounted(problem, p)
+
+
+@settings(max_examples=10, deadline=None)
+@given(st.integers(0, 10_000), st.sampled_from([5.0, 60.0, 200.0]))
+def test_running_tasks_are_kept_or_redone_and_plans_validate(seed, remaining_s) -> None:
+    problem = generate(6, 12, seed)
+    inspections = [a for a in problem.actions if isinstance(a, InspectAction)]
+    if not inspections:
+        return
+    target = inspections[0]
+    types = {t.id: t for t in problem.uav_types}
+    uavs = list(problem.uavs)
+    for i, u in enumerate(uavs):
+        if "inspect" in types[u.type].capabilities:
+            uavs[i] = msgspec.structs.replace(
+                u,
+                position_m=target.waypoints[0].position_m,
+                airborne=True,
+                running=RunningTask(action_id=target.id, index=0, remaining_s=remaining_s),
+            )
+            break
+    actions = tuple(msgspec.structs.replace(a, release_s=0.0) for a in problem.actions)
+    problem = msgspec.structs.replace(problem, uavs=tuple(uavs), actions=actions)
+    for p in (plan(problem), plan(problem, max_rounds=10)):
+        assert validate(problem, p) == []
+        accounted(problem, p)

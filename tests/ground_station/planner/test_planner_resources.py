@@ -9,6 +9,7 @@ import msgspec
 from ground_station.planner import (
     InspectAction,
     Problem,
+    RunningTask,
     Station,
     Waypoint,
     generate,
@@ -79,3 +80,32 @@ def test_time_preserving_removal_keeps_other_steps_in_time() -> None:
     smaller = replace(problem, actions=tuple(a for a in problem.actions if a.id != victim))
     ctx.problem = smaller
     assert validate(smaller, export(ctx)) == []
+
+
+def _running(fig6: Problem, remaining_s: float) -> Problem:
+    deliver = replace(fig6.actions[0], weight=5.0)
+    inspect = next(a for a in fig6.actions if a.id == "a4-inspect")
+    uav1 = replace(
+        fig6.uavs[0],
+        position_m=inspect.waypoints[0].position_m,
+        airborne=True,
+        running=RunningTask(action_id="a4-inspect", index=0, remaining_s=remaining_s),
+    )
+    return replace(fig6, uavs=(uav1, fig6.uavs[1]), actions=(inspect, deliver))
+
+
+def test_running_task_is_interrupted_only_when_j3_says_it_pays(fig6: Problem) -> None:
+    long_left = _running(fig6, 120.0)
+    result = plan(long_left)
+    assert validate(long_left, result) == []
+    kinds = [(s.kind, s.action_id) for s in result.uavs[0].steps]
+    first_inspect = kinds.index(("inspect", "a4-inspect"))
+    assert kinds.index(("deliver", "a1-deliver")) < first_inspect  # interrupted
+    resumed = result.uavs[0].steps[first_inspect]
+    assert resumed.index == 0 and resumed.end_s - resumed.arrive_s >= 5.0  # redone in full
+
+    short_left = _running(fig6, 5.0)
+    result = plan(short_left)
+    assert validate(short_left, result) == []
+    first = result.uavs[0].steps[0]
+    assert (first.kind, first.action_id, first.index) == ("inspect", "a4-inspect", 0)
