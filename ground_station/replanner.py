@@ -81,7 +81,12 @@ class Replanner:
         site, fleet = self.scenario.site, self.scenario.fleet
         problem = build_problem(site, fleet, self._uavs_now(), records, now_s)
         started = time.perf_counter()
-        result = pl.plan(problem, self.options)
+        try:
+            result = pl.plan(problem, self.options)
+        except pl.PlanningProblemError as exc:  # fleet reports that contradict each other
+            log.error("replan refused (%s): %s; plans kept", reason, exc)
+            self.events.emit(EventKind.FAULT, detail=f"replan refused: {exc}; plans kept")
+            return ReplanOutcome(self.store.counter("epoch"), [], {}, 0.0)
         elapsed = time.perf_counter() - started
         by_id = {r.action_id: r for r in records}
         new_tasks = {up.uav_id: to_tasks(up, site, fleet, by_id, now_s) for up in result.uavs}
@@ -146,13 +151,17 @@ class Replanner:
         return uavs
 
     def _running_action(self, uav_id: str) -> str | None:
-        """The monitoring or delivery action the UAV is executing, if any."""
-        status = self.monitor.status(uav_id)
+        """The monitoring action the UAV is executing, or the delivery whose
+        tool its telemetry says it holds, if any."""
+        status, telemetry = self.monitor.status(uav_id), self.monitor.telemetry(uav_id)
         plan = self.plans.get(uav_id)
         if status is None or status.task_id is None or plan is None:
             return None
         for task in plan.tasks:
-            if task.task_id == status.task_id and isinstance(task, MonitorTask | DeliverTask):
+            if task.task_id != status.task_id:
+                continue
+            holds_tool = telemetry is not None and telemetry.tool == getattr(task, "tool", None)
+            if isinstance(task, MonitorTask) or (isinstance(task, DeliverTask) and holds_tool):
                 return task.action_id
         return None
 

@@ -16,6 +16,7 @@ COMMANDS: dict[str, tuple[str, str]] = {
     "sim": ("sim_fleet.main:main", "run the MAVLink fleet simulator and human tracker"),
     "agent": ("onboard_agent.main:main", "run one UAV's onboard agent (or: agent tree)"),
     "gateway": ("ground_station.gateway.main:main", "run the operator REST API"),
+    "health": ("linecrew.health:main", "is a process's liveliness token up (healthchecks)"),
     "up": ("linecrew.launch.up:main", "run router, ground station, gateway, sim and agents"),
     "demo": ("linecrew.launch.demo:main", "the paper's scenario end to end"),
     "chaos": ("linecrew.chaos.main:main", "seeded partitions, kills, faults on a local fleet"),

@@ -8,6 +8,8 @@ from ground_station.missions import Conflict, NotFound
 from ground_station.validation import InvalidAction
 from proto import (
     ActionState,
+    AgentState,
+    AgentStatus,
     CancelAction,
     EventKind,
     InspectTask,
@@ -193,3 +195,15 @@ def test_battery_below_the_plan_replans_once_per_epoch(gs):
     gs.manager.on_telemetry(low)
     gs.manager.on_telemetry(low)
     assert gs.manager.counters.battery_replans == 1
+
+
+def test_a_status_ahead_of_telemetry_does_not_break_replanning(gs):
+    gs.submit("deliver-wrench")
+    drop = next(t for t in gs.latest("uav-1").tasks if t.task_id.endswith(".drop"))
+    # the status says "dropping" while telemetry does not (yet) show the tool held
+    gs.monitor.on_status(
+        AgentStatus(uav_id="uav-1", stamp_s=gs.now, state=AgentState.BUSY, task_id=drop.task_id)
+    )
+    gs.manager.replan("status ahead of telemetry")
+    assert gs.events[-1].kind == EventKind.REPLAN
+    assert gs.store.action("deliver-wrench").state == ActionState.PLANNED
