@@ -17,8 +17,10 @@
 # Idempotent: the CA and every existing certificate are kept; only what is
 # missing is created (a larger N adds the new UAVs, signed by the same CA).
 # FORCE=1 starts over with a new CA. Extra server names for the router:
-# ROUTER_SANS="DNS:gs.example,IP:10.0.0.2". Dev use only: keys are
-# unencrypted, the CA lives next to them.
+# ROUTER_SANS="DNS:gs.example,IP:10.0.0.2" (delete router.pem to reissue it).
+# Keys are mode 0600 for the user who runs this: a container running as
+# another user needs them readable (chown, or a copy per container).
+# Dev use only: keys are unencrypted and the CA key lives next to them.
 set -eu
 
 N=${1:-3}

@@ -38,6 +38,15 @@ def rule(rule_id: str, flows: list[str], messages: list[str], keys: list[str]) -
     }
 
 
+def health(name: str, token: str) -> list[dict]:
+    """``linecrew health ROLE ID`` (container healthchecks) runs with the
+    process's own identity and asks for its own liveliness token."""
+    return [
+        rule(f"{name}-health", IN, ["liveliness_query"], [token]),
+        rule(f"{name}-health-reply", OUT, ["liveliness_token"], [token]),
+    ]
+
+
 def service_rules(name: str) -> list[dict]:
     """What each ground-side process does on the bus (see the module docstrings
     of ground_station/service.py, ground_station/gateway, sim_fleet/main.py)."""
@@ -62,12 +71,12 @@ def service_rules(name: str) -> list[dict]:
             ),
             rule("gs-watch-tokens", OUT, ["liveliness_token"], ["alive/agent/*"]),
             rule("gs-token", IN, ["liveliness_token"], ["alive/gs/*"]),
+            *health("gs", "alive/gs/*"),
         ]
     if name == "gateway":
         return [
             rule("gateway-call", IN, ["query"], ["gs/rpc/*", "sim/fault"]),
             rule("gateway-call-replies", OUT, ["reply"], ["gs/rpc/*", "sim/fault"]),
-            rule("gateway-call-interest", OUT, ["declare_queryable"], ["gs/rpc/*", "sim/fault"]),
             rule("gateway-events", IN, ["declare_subscriber"], ["gs/events"]),
             rule("gateway-events-data", OUT, ["put", "delete"], ["gs/events"]),
             rule(
@@ -78,6 +87,7 @@ def service_rules(name: str) -> list[dict]:
             ),
             rule("gateway-gs-alive-tokens", OUT, ["liveliness_token"], ["alive/gs/*"]),
             rule("gateway-token", IN, ["liveliness_token"], ["alive/gateway/*"]),
+            *health("gateway", "alive/gateway/*"),
         ]
     if name == "sim":
         return [
@@ -86,6 +96,7 @@ def service_rules(name: str) -> list[dict]:
             rule("sim-poses", IN, ["put", "delete"], ["human/*/pose"]),
             rule("sim-poses-interest", OUT, ["declare_subscriber"], ["human/*/pose"]),
             rule("sim-token", IN, ["liveliness_token"], ["alive/sim/*"]),
+            *health("sim", "alive/sim/*"),
         ]
     if name == "operator":
         # CLI tools, `linecrew up/demo`'s watcher, benchmarks: read and ask, never publish
@@ -94,7 +105,6 @@ def service_rules(name: str) -> list[dict]:
         return [
             rule("operator-call", IN, ["query"], calls),
             rule("operator-call-replies", OUT, ["reply"], calls),
-            rule("operator-call-interest", OUT, ["declare_queryable"], calls),
             rule("operator-events", IN, ["declare_subscriber"], ["gs/events"]),
             rule("operator-events-data", OUT, ["put", "delete"], ["gs/events"]),
             rule(
@@ -114,22 +124,29 @@ def agent_rules(uav: str) -> list[dict]:
     the workers' poses and the ground stations' tokens; declares its token."""
     own_out = [f"uav/{uav}/telemetry", f"uav/{uav}/status", f"uav/{uav}/outcome"]
     plan = f"uav/{uav}/plan"
+    # The router tells a client which subscribers match what it publishes, and
+    # a client stops sending puts when it knows of none: "*-interest" rules let
+    # those declarations out (measured: without them publications stop after
+    # the first). The ground station subscribes with wildcards (uav/*/status),
+    # and a declaration passes only when a rule's key expression includes it
+    # whole, so the rule names the wildcard: metadata, never data. Queries need
+    # no such rule.
     return [
         rule(f"{uav}-pub", IN, ["put", "delete"], own_out),
-        rule(f"{uav}-pub-interest", OUT, ["declare_subscriber"], own_out),
+        rule(
+            f"{uav}-pub-interest",
+            OUT,
+            ["declare_subscriber"],
+            ["uav/*/telemetry", "uav/*/status", "uav/*/outcome"],
+        ),
         rule(f"{uav}-sub", IN, ["declare_subscriber"], [plan, "human/*/pose"]),
         rule(f"{uav}-sub-data", OUT, ["put", "delete"], [plan, "human/*/pose"]),
         rule(f"{uav}-plan-query", IN, ["query"], [plan]),
         rule(f"{uav}-plan-reply", OUT, ["reply"], [plan]),
-        rule(f"{uav}-plan-interest", OUT, ["declare_queryable"], [plan]),
-        rule(
-            f"{uav}-gs-alive",
-            IN,
-            ["declare_liveliness_subscriber", "liveliness_query"],
-            ["alive/gs/*"],
-        ),
+        rule(f"{uav}-gs-alive", IN, ["declare_liveliness_subscriber"], ["alive/gs/*"]),
         rule(f"{uav}-gs-alive-tokens", OUT, ["liveliness_token"], ["alive/gs/*"]),
         rule(f"{uav}-token", IN, ["liveliness_token"], [f"alive/agent/{uav}"]),
+        *health(uav, f"alive/agent/{uav}"),
     ]
 
 
@@ -163,6 +180,19 @@ def tls(tls_dir: str, name: str, side: str) -> dict:
     }
 
 
+def dump(value: object, indent: str = "") -> str:
+    """JSON (valid JSON5), with every flat object or list on one line."""
+    flat = json.dumps(value)
+    if len(indent) + len(flat) <= 100 or not isinstance(value, dict | list):
+        return flat
+    inner = indent + "  "
+    if isinstance(value, dict):
+        items = [f"{inner}{json.dumps(k)}: {dump(v, inner)}" for k, v in value.items()]
+        return "{\n" + ",\n".join(items) + f"\n{indent}}}"
+    items = [f"{inner}{dump(v, inner)}" for v in value]
+    return "[\n" + ",\n".join(items) + f"\n{indent}]"
+
+
 HEADER = """\
 // linecrew secured Zenoh profile: {what}.
 // Generated by deploy/zenoh/secure/render.py ({args}); edit the generator,
@@ -180,11 +210,11 @@ def render(tls_dir: str, uavs: list[str], args: str) -> dict[str, str]:
         "access_control": access_control(uavs),
     }
     what = f"router (mutual TLS, access control for {', '.join([*SERVICES, *uavs])})"
-    files["router.json5"] = HEADER.format(what=what, args=args) + json.dumps(router, indent=2)
+    files["router.json5"] = HEADER.format(what=what, args=args) + dump(router)
     for name in [*SERVICES, *uavs]:
         client = {"transport": {"link": {**only_tls, "tls": tls(tls_dir, name, "connect")}}}
         what = f"client `{name}` (certificate CN={name})"
-        text = HEADER.format(what=what, args=args) + json.dumps(client, indent=2)
+        text = HEADER.format(what=what, args=args) + dump(client)
         files[f"client-{name}.json5"] = text
     return {name: text + "\n" for name, text in files.items()}
 
@@ -199,9 +229,12 @@ def main(argv: list[str] | None = None) -> int:
     uavs = [*(f"uav-{i}" for i in range(1, (args.uavs or 0) + 1)), *args.uav]
     if not uavs:
         parser.error("give --uavs N or --uav ID")
-    summary = f"--tls-dir {args.tls_dir} " + (
-        f"--uavs {args.uavs}" if args.uavs and not args.uav else " ".join(f"--uav {u}" for u in uavs)
+    chosen = (
+        f"--uavs {args.uavs}"
+        if args.uavs and not args.uav
+        else " ".join(f"--uav {uav}" for uav in uavs)
     )
+    summary = f"--tls-dir {args.tls_dir} {chosen}"
     out = pathlib.Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     for name, text in render(args.tls_dir, uavs, summary).items():
