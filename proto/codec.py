@@ -5,7 +5,7 @@ nothing else, whatever the bytes.
 
 from __future__ import annotations
 
-import functools
+import threading
 from typing import Any, TypeVar
 
 import msgspec
@@ -25,9 +25,21 @@ class _Header(msgspec.Struct):
     schema_version: int = 0
 
 
-@functools.lru_cache(maxsize=256)
+_decoders: dict[Any, msgspec.msgpack.Decoder[Any]] = {}
+_decoders_lock = threading.Lock()
+
+
 def _decoder(message_type: Any) -> msgspec.msgpack.Decoder[Any]:
-    return msgspec.msgpack.Decoder(message_type)
+    """The cached decoder of ``message_type``. Built under a lock: two threads
+    building msgspec type information at once (Zenoh callbacks do) crashed
+    the interpreter."""
+    decoder = _decoders.get(message_type)
+    if decoder is None:
+        with _decoders_lock:
+            decoder = _decoders.get(message_type)
+            if decoder is None:
+                decoder = _decoders[message_type] = msgspec.msgpack.Decoder(message_type)
+    return decoder
 
 
 _header_decoder = msgspec.msgpack.Decoder(_Header)

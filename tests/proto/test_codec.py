@@ -132,3 +132,27 @@ def test_mutated_messages_only_ever_raise_decode_error(data):
     encoded[index] = data.draw(st.integers(0, 255))
     with contextlib.suppress(DecodeError):
         codec.decode(bytes(encoded), proto.Plan)
+
+
+def test_decoders_are_built_once_even_when_threads_race_for_them():
+    import threading
+
+    class Fresh(proto.Message, frozen=True, kw_only=True):  # a type nobody decoded yet
+        plan: proto.Plan
+        status: proto.AgentStatus | None = None
+
+    barrier = threading.Barrier(16)
+    built: list[object] = []
+
+    def first_use() -> None:
+        barrier.wait()
+        built.append(codec._decoder(Fresh))
+
+    threads = [threading.Thread(target=first_use) for _ in range(16)]
+    for thread in threads:
+        thread.start()
+    for thread in threads:
+        thread.join()
+    assert len(built) == 16 and all(d is built[0] for d in built)
+    message = Fresh(plan=_plan())
+    assert codec.decode(codec.encode(message), Fresh) == message
