@@ -79,7 +79,8 @@ class Replanner:
     def replan(self, records: list[ActionRecord], now_s: float, reason: str) -> ReplanOutcome:
         """Plan ``records`` (the actions in force) from the fleet's state now."""
         site, fleet = self.scenario.site, self.scenario.fleet
-        problem = build_problem(site, fleet, self._uavs_now(), records, now_s)
+        in_force = {r.action_id for r in records}
+        problem = build_problem(site, fleet, self._uavs_now(in_force), records, now_s)
         started = time.perf_counter()
         try:
             result = pl.plan(problem, self.options)
@@ -130,7 +131,7 @@ class Replanner:
         plan = self.plans.get(uav_id)
         return plan.tasks if plan else []
 
-    def _uavs_now(self) -> list[UavNow]:
+    def _uavs_now(self, in_force: set[str]) -> list[UavNow]:
         site, fleet = self.scenario.site, self.scenario.fleet
         uavs = []
         for spec in fleet.uavs:
@@ -145,20 +146,20 @@ class Replanner:
                     available=self.monitor.available(spec.id),
                     airborne=bool(telemetry and telemetry.flight_state in AIRBORNE),
                     tool=telemetry.tool if telemetry else None,
-                    running_action=self._running_action(spec.id),
+                    running_action=self._running_action(spec.id, in_force),
                 )
             )
         return uavs
 
-    def _running_action(self, uav_id: str) -> str | None:
-        """The monitoring action the UAV is executing, or the delivery whose
-        tool its telemetry says it holds, if any."""
+    def _running_action(self, uav_id: str, in_force: set[str]) -> str | None:
+        """The monitoring action in force the UAV is executing, or the delivery
+        whose tool its telemetry says it holds, if any."""
         status, telemetry = self.monitor.status(uav_id), self.monitor.telemetry(uav_id)
         plan = self.plans.get(uav_id)
         if status is None or status.task_id is None or plan is None:
             return None
         for task in plan.tasks:
-            if task.task_id != status.task_id:
+            if task.task_id != status.task_id or task.action_id not in in_force:
                 continue
             holds_tool = telemetry is not None and telemetry.tool == getattr(task, "tool", None)
             if isinstance(task, MonitorTask) or (isinstance(task, DeliverTask) and holds_tool):

@@ -207,3 +207,18 @@ def test_a_status_ahead_of_telemetry_does_not_break_replanning(gs):
     gs.manager.replan("status ahead of telemetry")
     assert gs.events[-1].kind == EventKind.REPLAN
     assert gs.store.action("deliver-wrench").state == ActionState.PLANNED
+
+
+def test_a_status_naming_a_finished_action_does_not_break_replanning(gs):
+    gs.submit("monitor-w2")
+    plan = next(p for p in reversed(gs.sent) if p.tasks)
+    watch = next(t for t in plan.tasks if t.action_id == "monitor-w2")
+    gs.monitor.on_status(
+        AgentStatus(
+            uav_id=plan.uav_id, stamp_s=gs.now, state=AgentState.BUSY, task_id=watch.task_id
+        )
+    )
+    gs.manager.cancel(CancelAction(request_id="c", action_id="monitor-w2"))
+    refused = [e for e in gs.events if e.kind == EventKind.FAULT and "refused" in e.detail]
+    assert refused == []
+    assert gs.events[-1].kind == EventKind.REPLAN
