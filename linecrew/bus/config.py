@@ -31,6 +31,8 @@ class BusConfig:
     keep_alive: int = 4  # keep-alive messages sent per lease period
     retry_ms: int = 250  # first reconnect period (doubles up to 4x)
     connect_attempt_ms: int = 1000  # one attempt to reach a router when opening
+    open_timeout_ms: int = 1000  # a transport handshake in flight; zenoh's 10 s default
+    # stalls a reconnect started during a short network cut for 10 s
     config_file: str | None = None  # a zenoh json5 file applied before the settings above
 
     @classmethod
@@ -69,6 +71,7 @@ class BusConfig:
             "scouting/multicast/enabled": self.multicast_scouting,
             "transport/link/tx/lease": self.lease_ms,
             "transport/link/tx/keep_alive": self.keep_alive,
+            "transport/unicast/open_timeout": self.open_timeout_ms,
         }
         for key, value in settings.items():
             config.insert_json5(key, json.dumps(value))
