@@ -161,6 +161,18 @@ def test_a_cut_longer_than_the_link_timeout_moves_the_work(fleet):
     poll(lambda: events_of(fleet, mark, "uav_back", uav), 30, f"{uav} back")
     poll(lambda: epoch(fleet, uav) > epoch_before, 30, f"{uav} holds a newer plan")
     assert others
+    # Not flown twice: the cut-off agent gave its watch up on its own (it reports
+    # the task failed once it can talk again; the ground station had already
+    # moved it, so the report is recorded as stale and changes nothing).
+    poll(
+        lambda: [
+            e
+            for e in events_of(fleet, mark, "fault", uav)
+            if "stale outcome cut-long" in e["detail"] and "failed" in e["detail"]
+        ],
+        30,
+        f"{uav} reports it abandoned cut-long",
+    )
     poll(lambda: completed(fleet, "cut-long"), 180, "cut-long completed")
 
 
