@@ -8,6 +8,7 @@ to the missing energy; a partial charge adds capacity x time / full time).
 from __future__ import annotations
 
 from math import dist
+from operator import add
 
 from ground_station.planner.model import Problem, Station, Uav, UavType, Vec3
 
@@ -60,16 +61,17 @@ def energy_after_recharge(
 
 
 class Site:
-    """Charging stations with a memoised nearest-station lookup."""
+    """Charging stations with memoised distance and nearest-station lookups."""
 
-    __slots__ = ("_cand", "_near", "by_id", "charging", "positions", "swap_s", "wh_s")
+    __slots__ = ("_cand", "_dists", "_near", "by_id", "charging", "positions", "swap_s", "wh_s")
 
     def __init__(self, problem: Problem) -> None:
         self.by_id = {s.id: s for s in problem.stations}
         self.charging = [s for s in problem.stations if s.pads > 0]
         self.positions = [s.position_m for s in self.charging]
         self._near: dict[Vec3, tuple[float, int]] = {}
-        self._cand: dict[tuple[Vec3, Vec3], list[int]] = {}
+        self._dists: dict[Vec3, list[float]] = {}
+        self._cand: dict[tuple[Vec3, Vec3], tuple[list[int], list[int], float]] = {}
         swaps = [s.swap_s for s in self.charging if s.recharge == "swap"]
         self.swap_s = min(swaps, default=float("inf"))
         charges = [s.full_charge_s for s in self.charging if s.recharge == "charge"]
@@ -81,32 +83,48 @@ class Site:
             return 0.0
         return min(self.swap_s, self.wh_s * missing_wh / capacity_wh)
 
+    def dists(self, pos: Vec3) -> list[float]:
+        """Distance (m) from ``pos`` to each charging station, by index."""
+        hit = self._dists.get(pos)
+        if hit is None:
+            hit = [dist(pos, sp) for sp in self.positions]
+            if len(self._dists) < 200_000:
+                self._dists[pos] = hit
+        return hit
+
     def nearest(self, pos: Vec3) -> tuple[float, int]:
         """(distance m, index in ``charging``) of the nearest charging station."""
         hit = self._near.get(pos)
         if hit is None:
             best = (float("inf"), -1)
-            for i, sp in enumerate(self.positions):
-                d = dist(pos, sp)
+            for i, d in enumerate(self.dists(pos)):
                 if d < best[0]:
                     best = (d, i)
             self._near[pos] = hit = best
         return hit
 
-    def candidates(self, a: Vec3, b: Vec3, limit: int = 3) -> list[int]:
-        """Charging stations worth trying between ``a`` and ``b`` (detour order)."""
+    def candidates(self, a: Vec3, b: Vec3, limit: int = 3) -> tuple[list[int], list[int], float]:
+        """Charging stations worth trying between ``a`` and ``b`` (detour
+        order), the other stations, and the shortest detour a -> station -> b
+        (m; inf without stations)."""
         key = (a, b)
         hit = self._cand.get(key)
-        if hit is not None:
-            return hit
+        if hit is None:
+            hit = self._detours(a, b, limit)
+            if len(self._cand) < 200_000:
+                self._cand[key] = hit
+        return hit
+
+    def _detours(self, a: Vec3, b: Vec3, limit: int) -> tuple[list[int], list[int], float]:
         n = len(self.positions)
+        detour = list(map(add, self.dists(a), self.dists(b)))
+        order = sorted(range(n), key=detour.__getitem__)  # stable: ties by index
+        shortest = detour[order[0]] if n else float("inf")
         if n <= limit:
-            return list(range(n))
-        scored = sorted((dist(a, sp) + dist(sp, b), i) for i, sp in enumerate(self.positions))
+            return list(range(n)), [], shortest
+        first = order[:limit]
         near_a = self.nearest(a)[1]
-        out = [i for _, i in scored[:limit]]
-        if near_a not in out:
-            out.append(near_a)
-        if len(self._cand) < 200_000:
-            self._cand[key] = out
-        return out
+        if near_a not in first:
+            first.append(near_a)
+        taken = set(first)
+        return first, [i for i in range(n) if i not in taken], shortest

@@ -20,7 +20,7 @@ from ground_station.planner.model import (
 )
 from ground_station.planner.routes import Ctx, Options, new_ctx, queue_order
 from ground_station.planner.simulate import State, Task
-from ground_station.planner.split import chunk, equal_chunks, fixed_split_count
+from ground_station.planner.split import chunk_all, equal_chunks, fixed_split_count
 
 SPLITS_TRIED = 1
 """How many split counts (best estimates first) are simulated per inspection."""
@@ -144,11 +144,10 @@ def place_inspect(ctx: Ctx, a: InspectAction, only: list[int] | None = None) -> 
             _place_chunk(ctx, a, [ok[j] for j in c])
         return
     max_split = min(2, ctx.options.max_split) if ctx.fast else ctx.options.max_split
-    splits = {
-        m: chunk(pts, serv, speed, m) for m in range(1, min(max_split, len(caps), len(ok)) + 1)
-    }
+    splits = chunk_all(pts, serv, speed, min(max_split, len(caps), len(ok)))
     # Simulate only the SPLITS_TRIED most promising split counts (by estimate).
-    ranked = sorted(splits, key=lambda m: (_estimate(ctx, a, ok, splits[m], caps), m))
+    fleet = _fleet(ctx, caps)
+    ranked = sorted(splits, key=lambda m: (_estimate(ctx, a, ok, splits[m], fleet), m))
     tried = sorted(ranked[:SPLITS_TRIED])
     if len(tried) == 1:
         for c in splits[tried[0]]:
@@ -170,34 +169,47 @@ def place_inspect(ctx: Ctx, a: InspectAction, only: list[int] | None = None) -> 
 
 
 def _estimate(
-    ctx: Ctx, a: InspectAction, ok: list[int], chunks: list[list[int]], caps: list[str]
+    ctx: Ctx, a: InspectAction, ok: list[int], chunks: list[list[int]], fleet: list[tuple]
 ) -> float:
     """Cheap score of a split: each chunk on the UAV that could finish it
-    first (tails only, no battery), as ``place_inspect`` scores real splits."""
+    first (tails only, no battery), as ``place_inspect`` scores real splits.
+    ``fleet``: ``(uid, tail time, tail position, speed, suitability cost)``."""
     wps = a.waypoints
+    release = a.release_s
     taken: set[str] = set()
     finish, used = ctx.problem.now_s, 0.0
     for c in chunks:
         pts = [wps[ok[j]].position_m for j in c]
         work = sum(wps[ok[j]].service_s for j in c)
         path = sum(dist(pts[i - 1], pts[i]) for i in range(1, len(pts)))
+        first = pts[0]
         best = None
-        for uid in caps:
+        for uid, t, pos, speed, suit_cost in fleet:
             if uid in taken:
                 continue
-            r = ctx.routes[uid]
-            st = r.tail()
-            k = r.kin
-            fin = max(st.t + dist(st.pos, pts[0]) / k.speed_mps, a.release_s)
-            fin += work + path / k.speed_mps
-            cost = fin + ctx.weights.suitability_s * k.caps["inspect"]
+            fin = t + dist(pos, first) / speed
+            if fin < release:
+                fin = release
+            fin += work + path / speed
+            cost = fin + suit_cost
             if best is None or cost < best[0]:
-                best = (cost, fin, fin - st.t, uid)
+                best = (cost, fin, fin - t, uid)
         if best is None:
             return float("inf")
         taken.add(best[3])
         finish, used = max(finish, best[1]), used + best[2]
     return finish + ctx.options.resource_factor * used
+
+
+def _fleet(ctx: Ctx, uids: list[str]) -> list[tuple]:
+    """The route tails ``_estimate`` scores chunks against."""
+    out = []
+    for uid in uids:
+        r = ctx.routes[uid]
+        st = r.tail()
+        k = r.kin
+        out.append((uid, st.t, st.pos, k.speed_mps, ctx.weights.suitability_s * k.caps["inspect"]))
+    return out
 
 
 def place_action(ctx: Ctx, a: Action, only: list[int] | None = None) -> None:

@@ -71,6 +71,47 @@ def gap_positions(ctx: Ctx, uid: str) -> list[int]:
     return out
 
 
+def _bounds(
+    ctx: Ctx,
+    uid: str,
+    positions: tuple[int, ...],
+    start: Vec3,
+    end: Vec3,
+    release_s: float,
+    part_s: float,
+    suit: float,
+    jv: float,
+) -> list[tuple[float, str, int]]:
+    """Lower bounds ``(cost, uid, pos)`` of inserting a part (``start`` ..
+    ``end``, ``part_s`` long) at each position of ``uid``'s route, leaving
+    out positions where it cannot fit before the next anchored task."""
+    r = ctx.routes[uid]
+    w = ctx.weights
+    now = ctx.problem.now_s
+    tasks, states = r.tasks, r.states
+    n = len(tasks)
+    speed = r.kin.speed_mps
+    travel, approach = w.travel, w.approach
+    # costs.complete_cost(w, suit, finish, now, 0.0, jv), unrolled
+    suit_cost, j3_cost = w.suitability_s * suit, w.interruption_s * jv
+    out = []
+    for pos in positions:
+        st = states[pos - 1] if pos > 0 else r.init
+        d0 = dist(st.pos, start)
+        fin = st.t + d0 / speed
+        if fin < release_s:
+            fin = release_s
+        fin += part_s
+        if pos < n:
+            nxt = tasks[pos]
+            anchor = nxt.anchor_s
+            if anchor is not None and fin + dist(end, nxt.pos) / speed > anchor:
+                continue
+        lb = suit_cost + travel * (fin - now) + j3_cost
+        out.append((lb + approach * d0 / speed, uid, pos))
+    return out
+
+
 def best_insertion(
     ctx: Ctx,
     kind: str,
@@ -102,34 +143,16 @@ def best_insertion(
         part_s = work_s + path_m / kin.speed_mps
         jv = costs.j3(ctx.running.get(uid), action_id)
         info[uid] = (suit, jv)
-        n = len(r.tasks)
-        positions = (n,) if paper else (n, *gap_positions(ctx, uid))
-        interrupt = None if paper or not ctx.pinned else preemption(ctx, uid, action_id)
-        if interrupt is not None:
-            positions = (*positions, -1)  # -1: before the running task
-        for pos in positions:
-            if pos < 0:
-                fin = max(r.init.t + dist(r.init.pos, start) / kin.speed_mps, release_s) + part_s
-                lb = costs.complete_cost(w, suit, fin, now, 0.0, jv + interrupt)
-                cands.append((lb, uid, pos))
-                continue
-            st = r.states[pos - 1] if pos > 0 else r.init
-            if paper:
-                lb = costs.paper_cost(w, suit, st, start, jv)
-            else:
-                d0 = dist(st.pos, start)
-                fin = st.t + d0 / kin.speed_mps
-                if fin < release_s:
-                    fin = release_s
-                fin += part_s
-                if pos < n:
-                    nxt = r.tasks[pos]
-                    back = dist(end or start, nxt.pos) / kin.speed_mps
-                    if nxt.anchor_s is not None and fin + back > nxt.anchor_s:
-                        continue
-                lb = costs.complete_cost(w, suit, fin, now, 0.0, jv)
-                lb += w.approach * d0 / kin.speed_mps
-            cands.append((lb, uid, pos))
+        if paper:
+            cands.append((costs.paper_cost(w, suit, r.tail(), start, jv), uid, len(r.tasks)))
+            continue
+        positions = (len(r.tasks), *gap_positions(ctx, uid))
+        cands += _bounds(ctx, uid, positions, start, end or start, release_s, part_s, suit, jv)
+        interrupt = preemption(ctx, uid, action_id) if ctx.pinned else None
+        if interrupt is not None:  # -1: before the running task
+            fin = max(r.init.t + dist(r.init.pos, start) / kin.speed_mps, release_s) + part_s
+            lb = costs.complete_cost(w, suit, fin, now, 0.0, jv + interrupt)
+            cands.append((lb, uid, -1))
     cands.sort()
     best: Choice | None = None
     reason = "battery_infeasible"

@@ -42,24 +42,42 @@ def _cover(ctx: Ctx, a: MonitorAction, t0: float, uids: list[str]) -> float | No
     return _cover_needs(ctx, a, [(t0, s, end) for s in range(a.k)], uids)
 
 
-def _slot_position_in_route(ctx: Ctx, uid: str, pos: Vec3, t: float, push: bool) -> int | None:
-    """Where in ``uid``'s route a segment at ``pos`` from ``t`` can go: the
-    end if the UAV is free by then; with ``push``, the last position from
-    which it can still get there (delaying what follows); else None."""
+def _push_position(ctx: Ctx, uid: str, pos: Vec3, t: float) -> int | None:
+    """The last position in ``uid``'s route from which a segment at ``pos``
+    from ``t`` can still be reached (delaying what follows); None if none."""
     r = ctx.routes[uid]
     speed = r.kin.speed_mps
     n = len(r.tasks)
-    st = r.tail()
-    if st.t + dist(st.pos, pos) / speed <= t + EPS_S:
-        return n
-    if not push:
-        return None
     lo = 1 if n and (r.tasks[0].action_id, r.tasks[0].index) in ctx.pinned else 0
     for p in range(n - 1, lo - 1, -1):
         st = r.state_before(p)
         if st.t + dist(st.pos, pos) / speed <= t + EPS_S:
             return p
     return None
+
+
+def _rank_uavs(
+    ctx: Ctx, fleet: list[tuple[str, float, float]], pos: Vec3, t: float, push: bool
+) -> list[tuple[float, str, float, int]]:
+    """``(rank cost, uid, suitability, route position)`` of each UAV in
+    ``fleet`` (``(uid, fixed cost, suitability)``) that can start a segment at
+    ``pos`` at ``t``: at the end of its route if it is free by then; with
+    ``push``, also before its later tasks (at a penalty)."""
+    out = []
+    for uid, fixed, suit in fleet:
+        r = ctx.routes[uid]
+        speed = r.kin.speed_mps
+        st = r.tail()
+        travel_s = dist(st.pos, pos) / speed
+        if st.t + travel_s <= t + EPS_S:
+            out.append((fixed + MON_TRAVEL * travel_s, uid, suit, len(r.tasks)))
+            continue
+        p = _push_position(ctx, uid, pos, t) if push else None
+        if p is not None:
+            travel_s = dist(r.state_before(p).pos, pos) / speed
+            out.append((fixed + MON_TRAVEL * travel_s + PUSH_PENALTY_S, uid, suit, p))
+    out.sort()
+    return out
 
 
 def _cover_needs(
@@ -77,34 +95,17 @@ def _cover_needs(
     heapq.heapify(need)
     end = max(e for _, _, e in needs)
     w = ctx.weights
+    fleet = []
+    for uid in uids:
+        suit = costs.j1(ctx.routes[uid].kin.caps, "monitor")
+        jv = costs.j3(ctx.running.get(uid), a.id)
+        fleet.append((uid, w.suitability_s * suit + w.interruption_s * jv, suit))
     suit_sum = 0.0
     handovers = 0
     while need:
         t, s, end = heapq.heappop(need)
         pos = slots[s]
-        pre = []
-        for uid in uids:
-            p = _slot_position_in_route(ctx, uid, pos, t, push)
-            if p is None:
-                continue
-            r = ctx.routes[uid]
-            st = r.state_before(p)
-            travel_s = dist(st.pos, pos) / r.kin.speed_mps
-            suit = costs.j1(r.kin.caps, "monitor")
-            jv = costs.j3(ctx.running.get(uid), a.id)
-            penalty = 0.0 if p == len(r.tasks) else PUSH_PENALTY_S
-            pre.append(
-                (
-                    w.suitability_s * suit
-                    + w.interruption_s * jv
-                    + MON_TRAVEL * travel_s
-                    + penalty,
-                    uid,
-                    suit,
-                    p,
-                )
-            )
-        pre.sort()
+        pre = _rank_uavs(ctx, fleet, pos, t, push)
         ranked = []
         for base, uid, suit, p in pre:
             if len(ranked) >= MAX_REACH:

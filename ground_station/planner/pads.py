@@ -2,8 +2,8 @@
 
 from __future__ import annotations
 
-from bisect import insort
-from collections.abc import Callable
+from bisect import bisect_left, insort
+from operator import itemgetter
 
 from ground_station.planner.energy import EPS_S
 
@@ -11,23 +11,36 @@ Ignore = tuple[str, float] | None
 """(uav_id, from_s): that UAV's reservations starting at or after from_s are
 ignored (they are being re-planned)."""
 
+_owner = itemgetter(2)
+
 
 class Pads:
-    """Reservations ``(start_s, end_s, uav_id)`` per charging-station index."""
+    """Reservations ``(start_s, end_s, uav_id)`` per charging-station index,
+    sorted by start."""
 
-    __slots__ = ("capacity", "slots")
+    __slots__ = ("capacity", "longest", "slots")
 
     def __init__(self, capacity: list[int]) -> None:
         self.capacity = capacity
         self.slots: list[list[tuple[float, float, str]]] = [[] for _ in capacity]
+        self.longest = [0.0] * len(capacity)  # no reservation was ever longer (s)
 
     def copy(self) -> Pads:
         other = Pads(self.capacity)
         other.slots = [list(s) for s in self.slots]
+        other.longest = list(self.longest)
         return other
 
+    def _after(self, si: int, t: float) -> list[tuple[float, float, str]]:
+        """Station ``si``'s reservations less those that surely end before
+        ``t`` (they start too early to last until then)."""
+        slots = self.slots[si]
+        i = bisect_left(slots, (t - self.longest[si] - 1.0,))
+        return slots[i:] if i else slots
+
     def _fits(self, busy: list[tuple[float, float]], cap: int, t: float, end: float) -> bool:
-        live = [(s, e) for s, e in busy if s < end - EPS_S and e > t + EPS_S]
+        lo, hi = t + EPS_S, end - EPS_S
+        live = [(s, e) for s, e in busy if s < hi and e > lo]
         if len(live) < cap:
             return True
         events = sorted([(max(s, t), 1) for s, _ in live] + [(e, -1) for _, e in live])
@@ -41,7 +54,7 @@ class Pads:
     def earliest(self, si: int, t_from: float, duration_s: float, ign: Ignore) -> float:
         """Earliest start >= ``t_from`` with a free pad for ``duration_s``."""
         cap = self.capacity[si]
-        slots = self.slots[si]
+        slots = self._after(si, t_from)
         if len(slots) < cap:
             return t_from
         if cap == 1:  # reservations never overlap and are sorted by start
@@ -55,13 +68,7 @@ class Pads:
                     break
                 t = e
             return t
-        lo = t_from + EPS_S
-        if ign is None:
-            busy = [(s, e) for s, e, _ in slots if e > lo]
-        else:
-            uid, from_s = ign
-            from_s -= EPS_S
-            busy = [(s, e) for s, e, u in slots if e > lo and not (u == uid and s >= from_s)]
+        busy = _busy(slots, t_from, ign)
         if len(busy) < cap:
             return t_from
         if self._fits(busy, cap, t_from, t_from + duration_s):
@@ -74,50 +81,42 @@ class Pads:
         return t
 
     def first_fit(
-        self,
-        si: int,
-        t_from: float,
-        t_max: float,
-        duration: Callable[[float], float],
-        min_s: float,
-        ign: Ignore,
+        self, si: int, t_from: float, t_max: float, full_s: float, min_s: float, ign: Ignore
     ) -> tuple[float, float] | None:
         """Earliest (start, length) with start in [t_from, t_max] and a free pad
-        for ``duration(start)`` seconds (which shrinks as start grows), at
-        least ``min_s``; None if there is none."""
+        for ``min(full_s, t_max - start)`` seconds, at least ``min_s``; None
+        if there is none."""
+        d = min(full_s, t_max - t_from)
+        if t_from > t_max + EPS_S or d < min_s - EPS_S or d <= EPS_S:
+            return None  # later starts are shorter still
         cap = self.capacity[si]
+        slots = self._after(si, t_from)
         if cap == 1:
             t = t_from
             uid, from_s = ign if ign is not None else ("", float("inf"))
             from_s -= EPS_S
-            for s, e, u in self.slots[si]:
+            for s, e, u in slots:
                 if e <= t + EPS_S or (u == uid and s >= from_s):
                     continue
-                if s >= t + duration(t) - EPS_S:
+                if s >= t + min(full_s, t_max - t) - EPS_S:
                     break
                 t = e
             if t > t_max + EPS_S:
                 return None
-            d = duration(t)
+            d = min(full_s, t_max - t)
             if d < min_s - EPS_S or d <= EPS_S:
                 return None
             return t, d
-        if ign is None:
-            busy = [(s, e) for s, e, _ in self.slots[si] if e > t_from + EPS_S]
-        else:
-            uid, from_s = ign
-            busy = [
-                (s, e)
-                for s, e, u in self.slots[si]
-                if e > t_from + EPS_S and not (u == uid and s >= from_s - EPS_S)
-            ]
-        for start in [t_from, *sorted({e for _, e in busy})]:
+        busy = _busy(slots, t_from, ign)
+        if len(busy) < cap or self._fits(busy, cap, t_from, t_from + d):
+            return t_from, d
+        for start in sorted({e for _, e in busy}):
             if start > t_max + EPS_S:
                 return None
-            d = duration(start)
+            d = min(full_s, t_max - start)
             if d < min_s - EPS_S or d <= EPS_S:
                 return None
-            if len(busy) < cap or self._fits(busy, cap, start, start + d):
+            if self._fits(busy, cap, start, start + d):
                 return start, d
         return None
 
@@ -125,8 +124,20 @@ class Pads:
         """Drop ``uav_id``'s reservations starting in [from_s, until_s)."""
         lo, hi = from_s - EPS_S, until_s - EPS_S
         for i, lst in enumerate(self.slots):
-            if any(u == uav_id for _, _, u in lst):
+            if uav_id in map(_owner, lst):
                 self.slots[i] = [r for r in lst if not (r[2] == uav_id and lo <= r[0] < hi)]
 
     def add(self, si: int, start_s: float, end_s: float, uav_id: str) -> None:
         insort(self.slots[si], (start_s, end_s, uav_id))
+        self.longest[si] = max(self.longest[si], end_s - start_s)
+
+
+def _busy(slots: list[tuple[float, float, str]], t_from: float, ign: Ignore) -> list:
+    """``(start, end)`` of the reservations ending after ``t_from``, leaving
+    out those ``ign`` names."""
+    lo = t_from + EPS_S
+    if ign is None:
+        return [(s, e) for s, e, _ in slots if e > lo]
+    uid, from_s = ign
+    from_s -= EPS_S
+    return [(s, e) for s, e, u in slots if e > lo and not (u == uid and s >= from_s)]

@@ -25,6 +25,9 @@ from ground_station.planner.state import State
 
 PAD_WAIT_S = 300.0
 """A recharge that waits longer than this for a pad makes us try every station."""
+LATE_MARGIN_S = 1e-3
+"""Slack over ``latest`` beyond which even the shortest detour is surely too
+late (far above rounding error and ``EPS_S``), so no station is tried."""
 
 
 class RcOption(NamedTuple):
@@ -60,17 +63,17 @@ def recharge_option(
     then if a shorter (partial) charge allows it (keeps later anchored tasks
     reachable).
     """
-    first = site.candidates(st.pos, target) if only is None else [only]
+    if only is not None:
+        return _rc_best(k, site, pads, st, target, release_s, latest, ign, target_wh, soft, [only])
+    first, rest, shortest_m = site.candidates(st.pos, target)
+    if latest is not None and st.t + shortest_m / k.speed_mps > latest + LATE_MARGIN_S:
+        return None  # no detour arrives in time
     best = _rc_best(k, site, pads, st, target, release_s, latest, ign, target_wh, soft, first)
-    if only is None and (best is None or best.wait_s > PAD_WAIT_S):
+    if best is None or best.wait_s > PAD_WAIT_S:
         # Pads near by are busy (or out of reach): look at every station.
-        rest = [i for i in range(len(site.positions)) if i not in first]
-        other = _rc_best(k, site, pads, st, target, release_s, latest, ign, target_wh, soft, rest)
-        if other is not None and (
-            best is None
-            or (other.arrive_task, -other.e_at_task) < (best.arrive_task, -best.e_at_task)
-        ):
-            best = other
+        best = _rc_best(
+            k, site, pads, st, target, release_s, latest, ign, target_wh, soft, rest, best
+        )
     return best
 
 
@@ -86,22 +89,27 @@ def _rc_best(
     target_wh: float | None,
     soft: float | None,
     stations: list[int],
+    best: RcOption | None = None,
 ) -> RcOption | None:
+    """``best`` or the first option at ``stations`` that beats it."""
     t, pos, e, _landed, _ = st
-    best: RcOption | None = None
+    speed, wh_per_m, capacity = k.speed_mps, k.wh_per_m, k.capacity_wh
+    floor_wh = k.reserve_wh - EPS_WH
+    d_from, d_to = site.dists(pos), site.dists(target)
     for si in stations:
         station = site.charging[si]
-        sp = site.positions[si]
-        d1 = dist(pos, sp)
-        ea = e - d1 * k.wh_per_m
-        if ea < k.reserve_wh - EPS_WH and d1 > 0.0:
+        d1 = d_from[si]
+        ea = e - d1 * wh_per_m
+        if ea < floor_wh and d1 > 0.0:
             continue
-        t_arr = t + d1 / k.speed_mps
-        tr2 = dist(sp, target) / k.speed_mps
-        dur = recharge_time_s(station, k.capacity_wh, ea)
+        t_arr = t + d1 / speed
+        tr2 = d_to[si] / speed
+        if latest is not None and t_arr > latest - tr2 + EPS_S:
+            continue  # cannot be on the pad before it must leave (``first_fit``)
+        dur = recharge_time_s(station, capacity, ea)
         if target_wh is not None and station.recharge == "charge":
-            want = min(k.capacity_wh, target_wh + tr2 * k.speed_mps * k.wh_per_m)
-            dur = min(dur, station.full_charge_s * max(0.0, want - ea) / k.capacity_wh)
+            want = min(capacity, target_wh + tr2 * speed * wh_per_m)
+            dur = min(dur, station.full_charge_s * max(0.0, want - ea) / capacity)
         if latest is None:
             start = pads.earliest(si, t_arr, dur, ign)
             if soft is not None and station.recharge == "charge":
@@ -109,24 +117,26 @@ def _rc_best(
                 if EPS_S < cap < dur:
                     dur = cap
         else:
-            full, last = dur, latest - tr2
+            if best is not None and max(capacity, ea) - tr2 * speed * wh_per_m <= best.e_at_task:
+                continue  # arrives at ``latest`` like ``best``, with no more energy
             need = station.swap_s if station.recharge == "swap" else EPS_S
-            fit = pads.first_fit(
-                si, t_arr, last, lambda s, full=full, last=last: min(full, last - s), need, ign
-            )
+            fit = pads.first_fit(si, t_arr, latest - tr2, dur, need, ign)
             if fit is None:
                 continue
             start, dur = fit
-        charged = energy_after_recharge(station, k.capacity_wh, ea, dur)
+        charged = energy_after_recharge(station, capacity, ea, dur)
         arrive = max(start + dur + tr2, release_s)
         if latest is not None:
             if arrive > latest + EPS_S:
                 continue
             arrive = latest
-        e_at = charged - tr2 * k.speed_mps * k.wh_per_m
-        cand = RcOption(si, start - t_arr, dur, ea, charged, arrive, e_at)
-        if best is None or (arrive, -e_at) < (best.arrive_task, -best.e_at_task):
-            best = cand
+        e_at = charged - tr2 * speed * wh_per_m
+        if (
+            best is None
+            or arrive < best.arrive_task
+            or (arrive == best.arrive_task and e_at > best.e_at_task)
+        ):
+            best = RcOption(si, start - t_arr, dur, ea, charged, arrive, e_at)
     return best
 
 
@@ -136,7 +146,7 @@ def emit_recharge(k: Kin, site: Site, st: State, rc: RcOption, steps: list, res:
     t, pos, _e, _landed, tool = st
     station = site.charging[rc.si]
     sp = site.positions[rc.si]
-    d1 = dist(pos, sp)
+    d1 = site.dists(pos)[rc.si]
     arr = t + d1 / k.speed_mps
     if rc.wait_s > EPS_S:
         steps.append(("wait", t, arr, arr + rc.wait_s, rc.e_before, sp, None, None, None, None, d1))
@@ -149,9 +159,10 @@ def emit_recharge(k: Kin, site: Site, st: State, rc: RcOption, steps: list, res:
 
 def next_hop(k: Kin, site: Site, st: State, target: Vec3) -> int | None:
     """The reachable charging station nearest ``target`` and nearer than us."""
+    d_from, d_to = site.dists(st.pos), site.dists(target)
+    floor_wh = k.reserve_wh - EPS_WH
     best, best_d = None, dist(st.pos, target) - 1.0
-    for si, sp in enumerate(site.positions):
-        d = dist(sp, target)
-        if d < best_d and st.e - dist(st.pos, sp) * k.wh_per_m >= k.reserve_wh - EPS_WH:
+    for si, d in enumerate(d_to):
+        if d < best_d and st.e - d_from[si] * k.wh_per_m >= floor_wh:
             best, best_d = si, d
     return best

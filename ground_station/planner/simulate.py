@@ -204,7 +204,7 @@ def monitor_reach(
         hop = recharge_option(k, site, pads, st, site.positions[si], 0.0, None, ign, None, si)
         if hop is None:
             return None
-        t_pad = st.t + dist(st.pos, site.positions[si]) / k.speed_mps + hop.wait_s
+        t_pad = st.t + site.dists(st.pos)[si] / k.speed_mps + hop.wait_s
         st = State(t_pad + hop.dur_s, site.positions[si], hop.e_charged, True, st.tool)
     return None
 

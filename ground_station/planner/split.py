@@ -14,38 +14,54 @@ from math import dist
 from ground_station.planner.model import Vec3
 
 
-def chunk(points: list[Vec3], service_s: list[float], speed_mps: float, m: int) -> list[list[int]]:
-    """Split indices ``0..n-1`` into ``m`` contiguous chunks (min-max work)."""
+def chunk_all(
+    points: list[Vec3], service_s: list[float], speed_mps: float, max_m: int
+) -> dict[int, list[list[int]]]:
+    """Split indices ``0..n-1`` into ``m`` contiguous chunks (min-max work),
+    for each ``m`` from 1 to ``min(max_m, n)`` (one table serves them all)."""
     n = len(points)
-    m = max(1, min(m, n))
-    if m == 1:
-        return [list(range(n))]
+    top = min(max_m, n)
     serv = [0.0]
     for s in service_s:
         serv.append(serv[-1] + s)
     legs = [0.0]
     for i in range(1, n):
         legs.append(legs[-1] + dist(points[i - 1], points[i]) / speed_mps)
-
-    def work(i: int, j: int) -> float:  # points i..j-1
-        return serv[j] - serv[i] + legs[j - 1] - legs[i]
-
     inf = float("inf")
     # best[c][j]: (max work, total work) splitting the first j points into c chunks
-    best = [[(inf, inf)] * (n + 1) for _ in range(m + 1)]
-    cut = [[0] * (n + 1) for _ in range(m + 1)]
+    best = [[(inf, inf)] * (n + 1) for _ in range(top + 1)]
+    cut = [[0] * (n + 1) for _ in range(top + 1)]
     best[0][0] = (0.0, 0.0)
-    for c in range(1, m + 1):
-        for j in range(c, n + 1):
-            for i in range(c - 1, j):
-                prev = best[c - 1][i]
-                if prev[0] == inf:
-                    continue
-                w = work(i, j)
-                cand = (max(prev[0], w), prev[1] + w)
-                if cand < best[c][j]:
-                    best[c][j] = cand
-                    cut[c][j] = i
+    for c in range(1, top + 1):
+        _fill_row(best[c - 1], best[c], cut[c], c, serv, legs)
+    return {m: _cuts(cut, m, n) for m in range(1, top + 1)}
+
+
+def _fill_row(
+    prev: list[tuple[float, float]],
+    row: list[tuple[float, float]],
+    cut: list[int],
+    c: int,
+    serv: list[float],
+    legs: list[float],
+) -> None:
+    """Best splits into ``c`` chunks from those into ``c - 1``; the work of
+    points i..j-1 is their service plus the flight between them."""
+    inf = float("inf")
+    for j in range(c, len(row)):
+        serv_j, legs_j = serv[j], legs[j - 1]
+        for i in range(c - 1, j):
+            p_max, p_sum = prev[i]
+            if p_max == inf:
+                continue
+            w = serv_j - serv[i] + legs_j - legs[i]
+            cand = (w if w > p_max else p_max, p_sum + w)
+            if cand < row[j]:
+                row[j] = cand
+                cut[j] = i
+
+
+def _cuts(cut: list[list[int]], m: int, n: int) -> list[list[int]]:
     out: list[list[int]] = []
     j = n
     for c in range(m, 0, -1):
