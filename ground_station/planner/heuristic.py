@@ -24,6 +24,8 @@ from ground_station.planner.split import chunk_all, equal_chunks, fixed_split_co
 
 SPLITS_TRIED = 1
 """How many split counts (best estimates first) are simulated per inspection."""
+RANDOM_SPLIT_P = 0.3
+"""Improvement only (``ctx.rng`` set): the chance of a random split count."""
 
 
 def reachable(ctx: Ctx, kind: str, pos: Vec3, service_s: float) -> bool:
@@ -149,6 +151,8 @@ def place_inspect(ctx: Ctx, a: InspectAction, only: list[int] | None = None) -> 
     fleet = _fleet(ctx, caps)
     ranked = sorted(splits, key=lambda m: (_estimate(ctx, a, ok, splits[m], fleet), m))
     tried = sorted(ranked[:SPLITS_TRIED])
+    if ctx.rng is not None and ctx.rng.random() < RANDOM_SPLIT_P:
+        tried = [ctx.rng.choice(ranked)]
     if len(tried) == 1:
         for c in splits[tried[0]]:
             _place_chunk(ctx, a, [ok[j] for j in c])

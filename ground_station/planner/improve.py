@@ -1,11 +1,14 @@
 """Bounded-time improvement: ruin and recreate over the heuristic's plan.
 
 Each round removes one to three related actions (a seed action and actions
-scheduled next to it on the same UAVs) and re-inserts them in queue order
-with the heuristic's cheapest insertion, now allowed between any two actions
-of a route. A round is kept only if the objective strictly improves:
-first fewer unplaced parts, then a smaller weight-averaged completion time
-plus makespan (seconds). The caller bounds the time: ``should_stop`` is polled
+scheduled next to it on the same UAVs) and re-inserts them with the
+heuristic's cheapest insertion, now allowed between any two actions of a
+route: in queue order, or, in half the rounds, randomised (shuffled order,
+suitability ignored, random split counts, monitoring segments cut short and
+random start times), which the CP-SAT reference showed the greedy misses:
+hand-overs before the battery forces them, and splits onto a second UAV.
+The objective is first fewer unplaced parts, then a smaller weight-averaged
+completion time plus makespan (seconds). The caller bounds the time: ``should_stop`` is polled
 between rounds (the library reads no clock) and ``max_rounds`` caps work.
 Deterministic for a given ``seed`` and sequence of ``should_stop`` answers.
 """
@@ -15,7 +18,10 @@ from __future__ import annotations
 import random
 from collections.abc import Callable
 
+from msgspec.structs import replace
+
 from ground_station.planner import heuristic
+from ground_station.planner.model import CostWeights
 from ground_station.planner.removal import remove_in_place
 from ground_station.planner.routes import Ctx, queue_order
 from ground_station.planner.simulate import Task
@@ -24,6 +30,8 @@ THRESHOLD = 0.002
 """Accept a round up to this fraction worse than the current state."""
 RESTART_AFTER = 60
 """Rounds without a new best before going back to the best state."""
+RANDOM_P = 0.5
+"""Share of rounds that re-insert with randomised choices (``_recreate``)."""
 
 
 def objective(ctx: Ctx) -> tuple[int, float]:
@@ -114,6 +122,7 @@ def improve(
     accepted = 0
     stale = 0
     worst: list[tuple[float, str]] = []
+    weights = ctx.weights
     ctx.anywhere = True
     try:
         for n in range(max_rounds):
@@ -127,8 +136,7 @@ def improve(
             snap = ctx.snapshot()
             ok = all(_remove(ctx, aid) for aid in group)
             if ok:
-                for a in queue_order([ctx.actions[aid] for aid in group]):
-                    heuristic.place_action(ctx, a)
+                _recreate(ctx, group, rng, weights)
                 score = objective(ctx)
                 if score < best:
                     best = current = score
@@ -153,5 +161,20 @@ def improve(
         if best_snap is not None:
             ctx.restore(best_snap)
     finally:
-        ctx.anywhere = False
+        ctx.anywhere, ctx.rng, ctx.weights = False, None, weights
     return accepted
+
+
+def _recreate(ctx: Ctx, group: list[str], rng: random.Random, weights: CostWeights) -> None:
+    """Re-insert ``group``: in queue order with the heuristic's own choices,
+    or (``RANDOM_P``) randomised: shuffled order, suitability ignored and
+    random monitoring choices (``monitor`` reads ``ctx.rng``)."""
+    actions = queue_order([ctx.actions[aid] for aid in group])
+    ctx.rng, ctx.weights = None, weights
+    if rng.random() < RANDOM_P:
+        ctx.rng = rng
+        rng.shuffle(actions)
+        if rng.random() < 0.5:
+            ctx.weights = replace(weights, suitability_s=0.0)
+    for a in actions:
+        heuristic.place_action(ctx, a)

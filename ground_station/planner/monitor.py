@@ -21,12 +21,22 @@ from ground_station.planner.routes import Ctx
 from ground_station.planner.simulate import Task, monitor_reach
 
 MAX_T0_CANDIDATES = 2
+"""Start times tried (the k-th earliest arrival, then later arrivals)."""
 MAX_REACH = 3
+"""UAVs (best first by suitability and distance) examined for each segment."""
 MON_TRAVEL = 1.0
 """Rank cost per second of flight to a slot (3 and 6 were worse on the bench)."""
 PUSH_PENALTY_S = 600.0
 """Extra rank cost of a repair segment that delays a UAV's later tasks."""
-"""UAVs (best first by suitability and distance) examined for each segment."""
+SHORTEN_P = 0.25
+SHORTEN = (0.2, 1.0)
+"""Improvement only: the chance that a candidate segment is cut short (to a
+uniform random fraction in this range of its reach), so a UAV can leave
+early for other work."""
+SHUFFLE_P = 0.2
+"""Improvement only: the chance that segment candidates are tried in random order."""
+RANDOM_T0 = 2
+"""Improvement only: random start times added to the candidates."""
 
 
 def slot_position(a: MonitorAction, slot: int) -> Vec3:
@@ -116,10 +126,14 @@ def _cover_needs(
             if reach is None:
                 continue
             seg_end = min(end, reach)
+            if ctx.rng is not None and ctx.rng.random() < SHORTEN_P:
+                seg_end = t + (seg_end - t) * ctx.rng.uniform(*SHORTEN)
             if seg_end < end - EPS_S and seg_end - t < min_seg:
                 continue
             ranked.append((base - (seg_end - t), uid, seg_end, suit, p))
         ranked.sort()
+        if ctx.rng is not None and len(ranked) > 1 and ctx.rng.random() < SHUFFLE_P:
+            ctx.rng.shuffle(ranked)
         for _, uid, seg_end, suit, p in ranked:
             task = Task("monitor", a.id, s, pos, seg_end - t, a.release_s, anchor_s=t)
             sim = ctx.try_insert(uid, p, [task])
@@ -184,6 +198,9 @@ def place_monitor(ctx: Ctx, a: MonitorAction) -> None:
     fallback += [last, last + a.duration_s, last + charge_s, last + 2 * (a.duration_s + charge_s)]
     if ctx.fast:
         fallback = [*fallback[:1], last + a.duration_s, last + 2 * (a.duration_s + charge_s)]
+    if ctx.rng is not None:
+        span = last + a.duration_s - base
+        primary += [base + ctx.rng.random() * span for _ in range(RANDOM_T0)]
     snap = ctx.snapshot()
     best: tuple[float, tuple] | None = None
     tried: set[float] = set()

@@ -6,6 +6,7 @@ a cheap tuple of references (used to try and roll back drafts).
 
 from __future__ import annotations
 
+import random
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from math import dist
@@ -84,6 +85,7 @@ class Ctx:
     pinned: set[tuple[str, int | None]] = field(default_factory=set)
     anywhere: bool = False  # improvement: also insert between any two actions
     fast: bool = False  # replanning: fewer alternatives per placement
+    rng: random.Random | None = None  # improvement: randomised placement choices
     emergency: dict[str, tuple[str, State, Kin]] = field(default_factory=dict)
     last_fail: Task | None = None  # the task that made the last removal fail
 
