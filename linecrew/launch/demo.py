@@ -22,6 +22,7 @@ from linecrew.client.gateway import Gateway, GatewayError
 from linecrew.client.render import timeline
 from linecrew.launch.local_run import LocalRun
 from linecrew.launch.recorder import ExecutionRecorder
+from linecrew.launch.secure import SecureProfileError
 from linecrew.launch.supervisor import StartError
 from linecrew.launch.up import add_run_arguments, options_from, scenario_from
 from linecrew.logs import configure_logging
@@ -130,7 +131,7 @@ def main(argv: list[str] | None = None) -> int:
             )
             assert run.bus is not None
             truth = run.bus.query(run.keys.sim("state"), GetSimState(), SimState, 5.0)
-    except (ScenarioError, StartError, GatewayError) as exc:
+    except (ScenarioError, StartError, GatewayError, SecureProfileError) as exc:
         print(f"linecrew demo: {exc}", file=sys.stderr)
         return 1
     rows = [(uav, "", segs) for uav, segs in sorted(recorder.segments.items())]

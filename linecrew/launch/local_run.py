@@ -16,6 +16,7 @@ import msgspec
 from linecrew.bus import Bus, BusConfig
 from linecrew.bus.router_process import free_port, port_open
 from linecrew.client.gateway import write_session
+from linecrew.launch import secure
 from linecrew.launch.ports import free_udp_block
 from linecrew.launch.supervisor import Supervisor
 from proto.keys import KeySpace, Role
@@ -33,6 +34,7 @@ class RunOptions:
     run_dir: pathlib.Path | None = None  # default runs/<UTC time>
     lease_ms: int = 500  # zenoh lease of every process
     start_timeout_s: float = 60.0  # per process
+    secure: bool = False  # mutual TLS and access control (``secure``)
 
 
 class LocalRun:
@@ -73,35 +75,49 @@ class LocalRun:
         self.run_dir.mkdir(parents=True, exist_ok=True)
         scenario_file = self.run_dir / "scenario.json"
         scenario_file.write_bytes(msgspec.json.encode(self.scenario))
+        uavs = [u.id for u in self.scenario.fleet.uavs]
         router_port = free_port()
-        self.endpoint = f"tcp/127.0.0.1:{router_port}"
-        common = [
-            "--connect",
-            self.endpoint,
-            "--lease-ms",
-            str(opts.lease_ms),
-            "--speedup",
-            str(opts.speedup),
-        ]
+        profile = secure.prepare(self.run_dir / "tls", uavs) if opts.secure else None
+        self.endpoint = f"{'tls/localhost' if profile else 'tcp/127.0.0.1'}:{router_port}"
+
+        def common(identity: str) -> list[str]:
+            config = ["--zenoh-config", profile.client_config(identity)] if profile else []
+            return [
+                *config,
+                "--connect",
+                self.endpoint,
+                "--lease-ms",
+                str(opts.lease_ms),
+                "--speedup",
+                str(opts.speedup),
+            ]
+
         sup, wait = self.supervisor, opts.start_timeout_s
 
         router = sup.start(
             "router",
             "ground_station.router",
+            *(["--zenoh-config", profile.router_config()] if profile else []),
             "--listen",
-            self.endpoint,
+            self.endpoint.replace("localhost", "127.0.0.1"),
             "--site",
             keys.site,
             "--lease-ms",
             str(opts.lease_ms),
         )
         sup.wait_ready(router, lambda: port_open(router_port), wait)
-        self.bus = Bus.open(BusConfig(connect=(self.endpoint,), lease_ms=opts.lease_ms))
+        self.bus = Bus.open(
+            BusConfig(
+                connect=(self.endpoint,),
+                lease_ms=opts.lease_ms,
+                config_file=profile.client_config("operator") if profile else None,
+            )
+        )
 
         gs = sup.start(
             "ground-station",
             "ground_station",
-            *common,
+            *common("gs"),
             "--scenario",
             str(scenario_file),
             "--db",
@@ -109,12 +125,11 @@ class LocalRun:
         )
         sup.wait_ready(gs, lambda: self._alive(Role.GROUND_STATION, "gs"), wait)
 
-        uavs = [u.id for u in self.scenario.fleet.uavs]
         base_port = free_udp_block(len(uavs))
         sim = sup.start(
             "sim",
             "sim_fleet",
-            *common,
+            *common("sim"),
             "--scenario",
             str(scenario_file),
             "--base-port",
@@ -128,7 +143,7 @@ class LocalRun:
         gateway = sup.start(
             "gateway",
             "ground_station.gateway",
-            *common,
+            *common("gateway"),
             "--scenario",
             str(scenario_file),
             "--port",
@@ -144,7 +159,7 @@ class LocalRun:
             agent = sup.start(
                 f"agent-{uav_id}",
                 "onboard_agent",
-                *common,
+                *common(uav_id),
                 "--uav",
                 uav_id,
                 "--scenario",

@@ -12,6 +12,7 @@ import pathlib
 import sys
 
 from linecrew.launch.local_run import LocalRun, RunOptions
+from linecrew.launch.secure import SecureProfileError
 from linecrew.launch.supervisor import StartError
 from linecrew.logs import configure_logging
 from linecrew.process import Shutdown
@@ -29,6 +30,11 @@ def add_run_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--speedup", type=float, default=1.0, help="mission seconds per second")
     parser.add_argument("--port", type=int, default=0, help="gateway port (default: free)")
     parser.add_argument("--run-dir", type=pathlib.Path, help="logs and store (runs/<time>)")
+    parser.add_argument(
+        "--secure",
+        action="store_true",
+        help="mutual TLS and access control on the bus (dev certificates in the run directory)",
+    )
     parser.add_argument("--log-level", default="warning")
 
 
@@ -42,7 +48,9 @@ def scenario_from(args: argparse.Namespace) -> Scenario:
 
 def options_from(args: argparse.Namespace) -> RunOptions:
     """Run options from the flags."""
-    return RunOptions(speedup=args.speedup, gateway_port=args.port, run_dir=args.run_dir)
+    return RunOptions(
+        speedup=args.speedup, gateway_port=args.port, run_dir=args.run_dir, secure=args.secure
+    )
 
 
 def event_line(event: GsEvent) -> str:
@@ -91,7 +99,7 @@ def main(argv: list[str] | None = None) -> int:
                         )
                     return 1
             print("stopping...", flush=True)
-    except (ScenarioError, StartError) as exc:
+    except (ScenarioError, StartError, SecureProfileError) as exc:
         print(f"linecrew up: {exc}", file=sys.stderr)
         return 1
     return 0
