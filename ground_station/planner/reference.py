@@ -12,6 +12,7 @@ plan the validator accepts:
   each monitoring slot split into up to ``SEGMENTS`` consecutive segments,
   each delivery's pick and drop) plus ``RECHARGES`` optional recharge visits
   per station, closed by the flight to the home station;
+- a UAV inspects the waypoints it takes of one action in index order;
 - a pick is followed directly by its drop; monitoring slots of an action
   start together at ``T0`` and segments hand over with no gap;
 - times are whole seconds (flights rounded up), energy whole joules (powers
@@ -309,6 +310,18 @@ class _Model:
                     self.model.add_implication(v[j], v[prev])
                     self.model.add(self.start[j] >= self.end[prev]).only_enforce_if(v[j])
                 prev = j
+        self._waypoint_order()
+
+    def _waypoint_order(self) -> None:
+        """A UAV inspects the waypoints of an action it takes in index order
+        (the action's waypoints are ordered; parts may go to several UAVs)."""
+        for v in self.visit.values():
+            mine = [j for j in sorted(v) if self.nodes[j].kind == "inspect"]
+            for a, i in enumerate(mine):
+                for j in mine[a + 1 :]:
+                    if self.nodes[i].action_id == self.nodes[j].action_id:
+                        both = [v[i], v[j]]
+                        self.model.add(self.start[j] >= self.end[i]).only_enforce_if(both)
 
     def _monitors(self, segments) -> None:  # type: ignore[no-untyped-def]
         md = self.model
