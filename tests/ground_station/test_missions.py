@@ -5,7 +5,6 @@ from __future__ import annotations
 import pytest
 
 from ground_station.missions import Conflict, NotFound
-from ground_station.planner import generate
 from ground_station.validation import InvalidAction
 from proto import (
     ActionState,
@@ -223,19 +222,3 @@ def test_a_status_naming_a_finished_action_does_not_break_replanning(gs):
     refused = [e for e in gs.events if e.kind == EventKind.FAULT and "refused" in e.detail]
     assert refused == []
     assert gs.events[-1].kind == EventKind.REPLAN
-
-
-def test_improved_replans_give_the_same_plan_for_the_same_state(tmp_path):
-    harness = Harness(str(tmp_path / "gs.db"))
-    harness.replanner.improve_work = 4000  # the ground station's default
-    harness.bring_up(*ALL)
-    for scripted in harness.scenario.actions:
-        assert harness.submit(scripted.id).state == ActionState.PLANNED
-    rounds = harness.replanner._rounds
-    assert (rounds(generate(3, 4)), rounds(generate(20, 50)), rounds(generate(50, 500))) == (
-        200,
-        4,
-        0,
-    )
-    again = harness.replanner.replan(harness.store.actions(), harness.now, "same state")
-    assert again.changed == []  # no new epochs for nothing
