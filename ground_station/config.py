@@ -16,7 +16,6 @@ class GsConfig:
     link_timeout_s: float = 5.0  # silence before a UAV is lost; > the agents' 3 s
     watchdog_period_s: float = 0.1  # how often the watchdog looks
     battery_margin_fraction: float = 0.1  # battery below the plan by this much -> replan
-    improve_work: int = 4000  # improvement per replan: rounds x actions x UAVs (0: none)
 
     @classmethod
     def from_env(cls, **overrides: object) -> GsConfig:
@@ -25,7 +24,6 @@ class GsConfig:
         for field in dataclasses.fields(cls):
             raw = os.environ.get(f"LINECREW_GS_{field.name.upper()}")
             if raw is not None:
-                kind = {"float": float, "int": int}.get(str(field.type), str)
-                values[field.name] = kind(raw)
+                values[field.name] = float(raw) if field.type == "float" else raw
         values.update({k: v for k, v in overrides.items() if v is not None})
         return cls(**values)  # type: ignore[arg-type]

@@ -29,11 +29,6 @@ def main(argv: list[str] | None = None) -> int:
         type=float,
         help="seconds of silence before a UAV is lost (default 5)",
     )
-    parser.add_argument(
-        "--improve-work",
-        type=int,
-        help="plan improvement per replan, rounds x actions x UAVs (default 4000, 0: none)",
-    )
     args = parser.parse_args(argv)
     bus_config = start(args, "ground-station")
     config = GsConfig.from_env(
@@ -41,7 +36,6 @@ def main(argv: list[str] | None = None) -> int:
         db_path=args.db_path,
         gs_id=args.gs_id,
         link_timeout_s=args.link_timeout_s,
-        improve_work=args.improve_work,
     )
     shutdown = Shutdown().install()
     try:

@@ -26,9 +26,6 @@ log = logging.getLogger(__name__)
 IMPOSSIBLE = frozenset({"unreachable_with_full_battery", "unknown_tool"})
 """Unplaced reasons that no change of fleet state can cure: the action fails."""
 
-IMPROVE_MAX_ROUNDS = 200
-"""Most improvement rounds per replan (small missions reach it)."""
-
 AIRBORNE = frozenset({FlightState.FLYING, FlightState.TAKING_OFF, FlightState.LANDING})
 
 
@@ -64,7 +61,6 @@ class Replanner:
         events: EventLog,
         send: Callable[[Plan], None],
         planner_options: pl.Options | None = None,
-        improve_work: int = 0,
     ) -> None:
         self.scenario = scenario
         self.store = store
@@ -72,7 +68,6 @@ class Replanner:
         self.events = events
         self.send = send
         self.options = planner_options
-        self.improve_work = improve_work
         self.plans: dict[str, Plan] = store.latest_plans()
         self.stats = ReplanStats()
         self._resend: set[str] = set()
@@ -88,7 +83,7 @@ class Replanner:
         problem = build_problem(site, fleet, self._uavs_now(in_force), records, now_s)
         started = time.perf_counter()
         try:
-            result = pl.plan(problem, self.options, max_rounds=self._rounds(problem))
+            result = pl.plan(problem, self.options)
         except pl.PlanningProblemError as exc:  # fleet reports that contradict each other
             log.error("replan refused (%s): %s; plans kept", reason, exc)
             self.events.emit(EventKind.FAULT, detail=f"replan refused: {exc}; plans kept")
@@ -131,13 +126,6 @@ class Replanner:
             detail=f"{reason}; {len(changed)} plan(s) changed in {elapsed * 1e3:.1f} ms",
         )
         return ReplanOutcome(epoch, changed, _action_events(records, new_tasks, result), elapsed)
-
-    def _rounds(self, problem: pl.Problem) -> int:
-        """Improvement rounds for this replan: a fixed count, so the same
-        state gives the same plan (no new epochs for nothing); it shrinks
-        with the problem so large missions keep replanning fast."""
-        size = max(1, len(problem.actions) * len(problem.uavs))
-        return min(IMPROVE_MAX_ROUNDS, self.improve_work // size)
 
     def _tasks(self, uav_id: str) -> list:
         plan = self.plans.get(uav_id)

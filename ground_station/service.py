@@ -55,7 +55,6 @@ class GroundStation:
             monitor=self.monitor,
             events=self.events,
             send=lambda plan: bus.publish(self.keys.plan(plan.uav_id), plan),
-            improve_work=config.improve_work,
         )
         self.manager = MissionManager(
             scenario=scenario,

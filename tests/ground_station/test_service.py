@@ -121,23 +121,12 @@ def test_brief_drop_out_changes_nothing_and_a_long_one_moves_the_work(client, ag
     victim.speak_again()
     events = history(client).events
     assert not [e for e in events if e.kind == EventKind.UAV_LOST]
-    epoch = victim.latest().epoch
     victim.go_silent()
-
-    def moved() -> bool:  # the inspection may be split: any other holder with a newer plan
-        return any(
-            a is not victim
-            and (p := a.latest()) is not None
-            and p.epoch > epoch
-            and any(t.action_id == "inspect-loop" for t in p.tasks)
-            for a in agents.values()
-        )
-
-    wait_until(moved, 15, "work moved")
+    wait_until(lambda: owner_of(agents, "inspect-loop") not in (None, victim), 15, "work moved")
     lost = [e for e in history(client).events if e.kind == EventKind.UAV_LOST]
     assert [e.uav_id for e in lost] == [victim.uav_id]
     victim.speak_again()
-    moved_epoch = max(p.epoch for a in agents.values() if a is not victim and (p := a.latest()))
+    moved_epoch = owner_of(agents, "inspect-loop").latest().epoch
     wait_until(lambda: victim.latest().epoch > moved_epoch, 15, "a fresh plan for the returner")
 
 
