@@ -1,15 +1,17 @@
 """Bounded-time improvement: ruin and recreate over the heuristic's plan.
 
-Each round removes one to three related actions (a seed action and actions
-scheduled next to it on the same UAVs) and re-inserts them with the
+Each round removes one to three related actions (a seed action: random, one
+of the costliest, or one of the last of the UAV that finishes last; and
+actions scheduled next to it on the same UAVs) and re-inserts them with the
 heuristic's cheapest insertion, now allowed between any two actions of a
 route: in queue order, or, in half the rounds, randomised (shuffled order,
 suitability ignored, random split counts, monitoring segments cut short and
 random start times), which the CP-SAT reference showed the greedy misses:
 hand-overs before the battery forces them, and splits onto a second UAV.
 The objective is first fewer unplaced parts, then a smaller weight-averaged
-completion time plus makespan (seconds). The caller bounds the time: ``should_stop`` is polled
-between rounds (the library reads no clock) and ``max_rounds`` caps work.
+completion time plus makespan (seconds), home legs included. The caller
+bounds the time: ``should_stop`` is polled between rounds (the library reads
+no clock) and ``max_rounds`` caps work.
 Deterministic for a given ``seed`` and sequence of ``should_stop`` answers.
 """
 
@@ -24,12 +26,15 @@ from ground_station.planner import heuristic
 from ground_station.planner.model import CostWeights
 from ground_station.planner.removal import remove_in_place
 from ground_station.planner.routes import Ctx, queue_order
-from ground_station.planner.simulate import Task
+from ground_station.planner.simulate import Task, home_steps
 
 THRESHOLD = 0.002
 """Accept a round up to this fraction worse than the current state."""
 RESTART_AFTER = 60
 """Rounds without a new best before going back to the best state."""
+LATE_P = 0.2
+"""Share of rounds that move one of the last tasks of the UAV that finishes
+last (the makespan), rather than a high-cost or random action."""
 RANDOM_P = 0.5
 """Share of rounds that re-insert with randomised choices (``_recreate``)."""
 
@@ -37,17 +42,18 @@ RANDOM_P = 0.5
 def objective(ctx: Ctx) -> tuple[int, float]:
     """(unplaced parts, weight-averaged completion + makespan) of the state.
 
-    Home legs are left out (they follow from the last tasks); ``export``
-    computes the exact metrics.
+    The makespan counts each UAV's way home, with a recharge first where one
+    is needed (as ``export`` adds it, but without pad contention between the
+    UAVs going home).
     """
     now = ctx.problem.now_s
     comp: dict[str, float] = {}
     makespan = now
     for r in ctx.routes.values():
-        if not r.steps:
-            continue
-        if r.steps[-1][3] > makespan:
-            makespan = r.steps[-1][3]
+        home, _ = home_steps(r.kin, ctx.site, ctx.pads, r.tail(), None)
+        t = home[-1][3] if home else r.tail()[0]
+        if t > makespan:
+            makespan = t
         for s in r.steps:
             aid = s[6]
             if aid is not None and s[3] > comp.get(aid, -1e300):
@@ -77,6 +83,12 @@ def _related(ctx: Ctx, seed: str, rng: random.Random, size: int) -> list[str]:
     head, rest = out[:1], out[1:]
     rng.shuffle(rest)
     return head + rest[: size - 1]
+
+
+def _late(ctx: Ctx) -> list[str]:
+    """Actions among the last tasks of the UAV that finishes last."""
+    r = max(ctx.routes.values(), key=lambda r: r.tail()[0])
+    return [t.action_id for t in r.tasks[-3:] if (t.action_id, t.index) not in ctx.pinned]
 
 
 def _remove(ctx: Ctx, aid: str) -> bool:
@@ -130,8 +142,14 @@ def improve(
                 break
             if n % 25 == 0:
                 worst = _contributions(ctx)[:20]
-            use_worst = bool(worst) and rng.random() < 0.5
-            seed_id = rng.choice(worst)[1] if use_worst else rng.choice(ids)
+            x = rng.random()
+            late = _late(ctx) if x < LATE_P else []
+            if late:
+                seed_id = rng.choice(late)
+            elif worst and x < 0.5:
+                seed_id = rng.choice(worst)[1]
+            else:
+                seed_id = rng.choice(ids)
             group = _related(ctx, seed_id, rng, rng.choice((1, 1, 2, 3)))
             snap = ctx.snapshot()
             ok = all(_remove(ctx, aid) for aid in group)

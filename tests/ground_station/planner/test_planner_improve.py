@@ -3,6 +3,7 @@
 
 from __future__ import annotations
 
+import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
@@ -85,3 +86,14 @@ def test_time_bounded_improvement_runs_independent_restarts() -> None:
     out = plan(problem, should_stop=lambda: next(polls) >= 2500)
     assert validate(problem, out) == []
     assert score(out) <= score(plan(problem, max_rounds=600))
+
+
+def test_objective_is_the_exported_score_home_legs_included() -> None:
+    # Here UAVs recharge before flying home at the end; an objective without
+    # the home legs was 400 s below the plan's score and misled the search.
+    problem = generate(5, 20, 0)
+    ctx = build(problem)
+    improve(ctx, lambda: False, max_rounds=50)
+    exported = export(ctx)
+    assert any(u.steps[-2].kind == "recharge" for u in exported.uavs if len(u.steps) > 1)
+    assert objective(ctx) == (score(exported)[0], pytest.approx(score(exported)[1]))
