@@ -80,8 +80,7 @@ def plan(
     false, then runs local search (``improve``) in independent runs of
     ``RUN_ROUNDS`` rounds from the ``START_COUNT`` best of them in turn while
     time remains (one run of ``max_rounds`` from the best if that is given);
-    the result is never worse than the
-    complete or the paper heuristic's plan.
+    the result is never worse than the complete or the paper heuristic's plan.
     ``should_stop`` is polled between constructions and rounds: pass e.g. a
     deadline check built on the caller's clock. Pure and deterministic for a
     given sequence of ``should_stop`` answers. Raises ``PlanningProblemError``
