@@ -3,7 +3,10 @@ with N light agents over a real router on loopback.
 
 1. Event -> new plan received: an operator submits an action; the time until
    every agent whose plan changed has received it (p50 / p99 over events).
-2. Silence -> lost -> replan: an agent process is ``kill -9``ed; the time
+2. Plan stability: the plan epochs issued per submitted action (at most
+   one per real trigger), and per UAV per mission-minute over ``--steady-s``
+   seconds in which nothing happens (target 0).
+3. Silence -> lost -> replan: an agent process is ``kill -9``ed; the time
    until the ground station announces it lost and replans, against the
    configured ``--link-timeout``.
 """
@@ -122,6 +125,27 @@ def _event_to_plan(
     return latencies
 
 
+def _stability(
+    watch: _EventWatch, since: float, uavs: int, events: int, steady_s: float
+) -> dict[str, float]:
+    """Epochs per trigger during the submissions (from ``since``), then per
+    UAV per minute while nothing happens (the gs runs at x1)."""
+    changes = [(t, e) for t, e in watch.items if e.kind == EventKind.PLAN_CHANGED]
+    epochs = {e.epoch for t, e in changes if t >= since}
+    before = {e.epoch for t, e in changes if t < since}
+    quiet_from = time.perf_counter()
+    time.sleep(steady_s)
+    quiet = {
+        e.epoch
+        for t, e in watch.items
+        if e.kind == EventKind.PLAN_CHANGED and t >= quiet_from and e.epoch not in epochs | before
+    }
+    return {
+        "epochs_per_submit": len(epochs) / max(1, events),
+        "steady_epochs_per_uav_min": len(quiet) / uavs / (steady_s / 60.0),
+    }
+
+
 def doomed_agent(endpoint: str, scenario_file: str, uav_id: str, lease_ms: int) -> None:
     """Child-process body: a light agent (token + 5 Hz telemetry) until killed."""
     scenario = msgspec.json.decode(pathlib.Path(scenario_file).read_bytes(), type=Scenario)
@@ -163,7 +187,9 @@ def _silence_to_lost(
     }
 
 
-def run(uavs: int, events: int, link_timeout_s: float, lease_ms: int, seed: int) -> dict:
+def run(
+    uavs: int, events: int, link_timeout_s: float, lease_ms: int, seed: int, steady_s: float = 20.0
+) -> dict:
     """Run both measurements; returns the numbers."""
     scenario = with_fleet_size(load("paper"), uavs + 1)
     keys = KeySpace(scenario.site.id)
@@ -203,7 +229,9 @@ def run(uavs: int, events: int, link_timeout_s: float, lease_ms: int, seed: int)
                     agents[spec.id] = LightAgent(config, scenario, spec.id)
                 while not all(a.plans for a in agents.values()):
                     time.sleep(0.01)
+                submitted = time.perf_counter()
                 latencies = sorted(_event_to_plan(client, keys, agents, watch, events, seed))
+                stability = _stability(watch, submitted, uavs, events, steady_s)
                 lost = _silence_to_lost(
                     endpoint, scenario_file, scenario.fleet.uavs[-1].id, lease_ms, watch
                 )
@@ -218,6 +246,7 @@ def run(uavs: int, events: int, link_timeout_s: float, lease_ms: int, seed: int)
         "events": len(latencies),
         "event_to_plan_p50_ms": p(0.5) if latencies else float("nan"),
         "event_to_plan_p99_ms": p(0.99) if latencies else float("nan"),
+        **stability,
         "link_timeout_s": link_timeout_s,
         **lost,
     }
@@ -235,9 +264,12 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--link-timeout", type=float, default=5.0, help="gs_link_timeout (s)")
     parser.add_argument("--lease-ms", type=int, default=500, help="zenoh transport lease")
     parser.add_argument("--seed", type=int, default=1)
+    parser.add_argument("--steady-s", type=float, default=20.0, help="quiet time watched (s)")
     parser.add_argument("--json", action="store_true", help="print JSON")
     args = parser.parse_args(argv)
-    results = run(args.uavs, args.events, args.link_timeout, args.lease_ms, args.seed)
+    results = run(
+        args.uavs, args.events, args.link_timeout, args.lease_ms, args.seed, args.steady_s
+    )
     if args.json:
         print(json.dumps(results, indent=2))
     else:

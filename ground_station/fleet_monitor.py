@@ -4,7 +4,9 @@ Presence comes from each agent's liveliness token plus the freshness of its
 telemetry. A UAV silent (token gone, or no telemetry) for less than
 ``link_timeout_s`` is still present: brief drop-outs cause nothing. Longer,
 it is *lost* and its work goes to others; when token and telemetry return it
-is *back*. UAVs never heard since start-up begin as lost (without an event).
+is *back*. A UAV whose telemetry says it crashed, or whose agent says it
+failed, is reported at once, without the grace, and takes no work until it
+reports otherwise. UAVs never heard since start-up begin as lost (without an event).
 Time is injected: :meth:`FleetMonitor.check` is called with the clock's now.
 """
 
@@ -30,6 +32,8 @@ class Change(enum.StrEnum):
 
     LOST = "lost"
     BACK = "back"
+    CRASHED = "crashed"  # telemetry says crashed (or disarmed in the air): lost at once
+    FAILED = "failed"  # the agent reports itself failed (e.g. no autopilot): lost at once
 
 
 @dataclasses.dataclass
@@ -41,6 +45,16 @@ class _Uav:
     lost_s: float | None = None
     telemetry: Telemetry | None = None
     status: AgentStatus | None = None
+    down: Change | None = None  # CRASHED / FAILED already reported for the current spell
+
+
+def _down(uav: _Uav) -> Change | None:
+    """Whether the UAV's own reports say it cannot fly any more."""
+    if uav.telemetry is not None and uav.telemetry.flight_state == FlightState.CRASHED:
+        return Change.CRASHED
+    if uav.status is not None and uav.status.state == AgentState.FAILED:
+        return Change.FAILED
+    return None
 
 
 class FleetMonitor:
@@ -87,6 +101,10 @@ class FleetMonitor:
         """Apply the timeout; return the UAVs that became lost or came back."""
         changes: list[tuple[str, Change]] = []
         for uav_id, uav in self._uavs.items():
+            down = _down(uav)
+            if down is not None and uav.down is None and not uav.lost:
+                changes.append((uav_id, down))
+            uav.down = down
             silent = self.silence_s(uav_id, now_s) >= self.link_timeout_s
             if silent and not uav.lost:
                 uav.lost, uav.lost_s = True, now_s

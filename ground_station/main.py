@@ -39,7 +39,7 @@ def main(argv: list[str] | None = None) -> int:
     )
     shutdown = Shutdown().install()
     try:
-        scenario = load(config.scenario)
+        scenario = load(config.scenario, site=args.site)
         bus = Bus.open(bus_config, should_stop=shutdown.is_set)
     except (ScenarioError, Unavailable) as exc:
         log.error("ground station cannot start: %s", exc)

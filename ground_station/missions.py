@@ -15,6 +15,7 @@ from collections.abc import Callable
 
 import msgspec
 
+from ground_station import inventory, progress
 from ground_station.event_log import EventLog
 from ground_station.fleet_monitor import Change, FleetMonitor
 from ground_station.lifecycle import TERMINAL, ActionEvent, next_state
@@ -24,8 +25,16 @@ from ground_station.store import Store
 from ground_station.validation import validate
 from proto.errors import RequestError
 from proto.events import EventKind
-from proto.mission import ActionRecord, ActionState
-from proto.plan import Plan
+from proto.mission import ActionRecord, ActionState, DeliverAction
+from proto.plan import (
+    DeliverTask,
+    InspectTask,
+    MonitorTask,
+    PickTask,
+    Plan,
+    RechargeTask,
+    Task,
+)
 from proto.rpc import (
     ActionList,
     ActionReply,
@@ -44,9 +53,42 @@ from proto.rpc import (
     SubmitAction,
 )
 from proto.scenario import Scenario
-from proto.telemetry import TaskOutcome, Telemetry
+from proto.telemetry import (
+    AgentState,
+    AgentStatus,
+    FlightState,
+    OutcomeResult,
+    TaskOutcome,
+    Telemetry,
+)
 
 log = logging.getLogger(__name__)
+
+ROUND_SLACK_S = 5.0
+"""Monitoring segments planned to end within this of each other end one round."""
+LIVE_PROGRESS_STEP = 0.02
+"""A monitoring action's stored progress follows its flown share in steps of this."""
+DROP_RADIUS_M = 3.0
+"""A tool released farther than this (horizontally) from the worker was not delivered."""
+
+FLEET_EVENTS = {
+    Change.LOST: EventKind.UAV_LOST,
+    Change.BACK: EventKind.UAV_BACK,
+    Change.CRASHED: EventKind.UAV_CRASHED,
+    Change.FAILED: EventKind.UAV_LOST,
+}
+FLEET_TEXT = {
+    Change.LOST: "silent past the link timeout; its work goes to others",
+    Change.BACK: "heard again; it gets a fresh plan",
+    Change.CRASHED: "telemetry says crashed; its work goes to others at once",
+    Change.FAILED: "its agent reports failed; its work goes to others at once",
+}
+
+ACTION_TASKS = (InspectTask, MonitorTask, PickTask, DeliverTask)
+"""Tasks whose completion is a replanning trigger (the paper's "task
+finished"). A finished wait, recharge or flight home changes nothing the
+plan did not already expect, so it replans nothing, unless an action is
+waiting for a UAV (then a UAV back on its pad or recharged may take it)."""
 
 
 class NotFound(RequestError):
@@ -93,6 +135,7 @@ class MissionManager:
         self.battery_margin_fraction = battery_margin_fraction
         self.counters = Counters()
         self._battery_flagged: dict[str, int] = {}
+        self._carried: dict[str, str] = {}  # the last tool each UAV's telemetry showed
 
     # -- requests --------------------------------------------------------------
 
@@ -127,6 +170,8 @@ class MissionManager:
                 raise Conflict("request_id already used for another action", field="request_id")
             return existing
         validate(request.action, self.scenario.site, self.scenario.fleet)
+        if isinstance(request.action, DeliverAction):
+            inventory.reserve(self.scenario.site, self.store.actions(), request.action)
         action_id = request.action_id or f"act-{self.store.next_counter('action'):05d}"
         if self.store.action(action_id) is not None:
             raise Conflict(f"action id {action_id!r} exists", field="action_id")
@@ -157,6 +202,9 @@ class MissionManager:
         if request.priority is not None:
             action = msgspec.structs.replace(action, priority=request.priority)
         validate(action, self.scenario.site, self.scenario.fleet)
+        if isinstance(action, DeliverAction):
+            others = [r for r in self.store.actions() if r.action_id != record.action_id]
+            inventory.reserve(self.scenario.site, others, action)
         self._save(msgspec.structs.replace(record, action=action), record.state, "modified")
         self.events.emit(EventKind.ACTION_CHANGED, action_id=record.action_id)
         self.replan(f"action {record.action_id} changed")
@@ -188,6 +236,8 @@ class MissionManager:
                 detail=f"stale outcome {outcome.task_id} {outcome.result}",
             )
             return
+        if isinstance(task, DeliverTask) and outcome.result == OutcomeResult.COMPLETED:
+            outcome = self._confirm_drop(outcome, task)
         if task.action_id is not None:
             record = self.store.action(task.action_id)
             if record is not None and record.state not in TERMINAL:
@@ -195,14 +245,124 @@ class MissionManager:
                 self._save(updated, record.state, f"{outcome.task_id} {outcome.result}")
                 if event is not None:
                     self._transition(updated, event, f"{outcome.task_id} {outcome.result}")
-        self.replan(f"{outcome.uav_id} {outcome.task_id} {outcome.result}")
+        if isinstance(task, MonitorTask) and outcome.result == OutcomeResult.COMPLETED:
+            self._announce_handover(outcome.uav_id, task)
+        self.replanner.finished(outcome.uav_id, outcome.task_id)
+        trigger = (
+            outcome.result != OutcomeResult.COMPLETED
+            or isinstance(task, ACTION_TASKS)
+            or self._waiting_for_a_uav()
+        )
+        if trigger and not self._round_ending(outcome.uav_id, task):
+            self.replan(f"{outcome.uav_id} {outcome.task_id} {outcome.result}")
+
+    def _waiting_for_a_uav(self) -> bool:
+        """Whether an action in force is unplaced for now (no UAV could take it
+        at the last replan): a UAV that landed or recharged may cure that."""
+        return bool(self.store.actions([ActionState.ACCEPTED]))
+
+    def _round_ending(self, uav_id: str, task: Task) -> bool:
+        """Whether ``task`` is one of a monitoring action's k segments that end
+        together, and another of them has yet to report: the last one replans
+        (one replan per round, from complete accounting)."""
+        if not isinstance(task, MonitorTask) or task.end_s <= 0:
+            return False
+        for other_uav, plan in self.replanner.plans.items():
+            if other_uav == uav_id or not self.monitor.available(other_uav):
+                continue
+            for other in plan.tasks:
+                if (
+                    isinstance(other, MonitorTask)
+                    and other.action_id == task.action_id
+                    and abs(other.end_s - task.end_s) <= ROUND_SLACK_S
+                ):
+                    return True
+        return False
+
+    def _announce_handover(self, leaving: str, task: MonitorTask) -> None:
+        """A segment ended: if another UAV holds the same slot next, say so."""
+        for uav_id, plan in self.replanner.plans.items():
+            if uav_id == leaving:
+                continue
+            for other in plan.tasks:
+                same_slot = isinstance(other, MonitorTask) and other.slot == task.slot
+                if same_slot and other.action_id == task.action_id:
+                    self.events.emit(
+                        EventKind.HANDOVER,
+                        action_id=task.action_id,
+                        uav_id=uav_id,
+                        detail=f"slot {task.slot} of {task.worker_id}: {leaving} -> {uav_id}",
+                    )
+                    return
+
+    def _confirm_drop(self, outcome: TaskOutcome, task: DeliverTask) -> TaskOutcome:
+        """A delivery counts as done only if telemetry showed the requested tool
+        carried and the UAV is at the worker; otherwise it is a failed drop."""
+        carried = self._carried.pop(outcome.uav_id, None)
+        problem = None
+        if carried != task.tool:
+            problem = f"telemetry showed {carried or 'no tool'} carried, not {task.tool}"
+        elif (away := self._away_from_worker(outcome.uav_id, task.worker_id)) is not None:
+            problem = f"released {away:.1f} m from {task.worker_id}"
+        if problem is None:
+            return outcome
+        self.events.emit(
+            EventKind.FAULT, uav_id=outcome.uav_id, detail=f"delivery not confirmed: {problem}"
+        )
+        return msgspec.structs.replace(outcome, result=OutcomeResult.FAILED, reason=problem)
+
+    def _away_from_worker(self, uav_id: str, worker_id: str) -> float | None:
+        """How far (horizontally) the UAV is from a worker who stands still,
+        if farther than ``DROP_RADIUS_M``; None when close or not checkable."""
+        telemetry = self.monitor.telemetry(uav_id)
+        worker = self.scenario.site.worker(worker_id)
+        if telemetry is None or worker is None or worker.path:
+            return None
+        p, w = telemetry.position, worker.position
+        away = ((p.x_m - w.x_m) ** 2 + (p.y_m - w.y_m) ** 2) ** 0.5
+        return away if away > DROP_RADIUS_M else None
+
+    def on_status(self, status: AgentStatus) -> None:
+        """Show a monitoring action's progress while it is flown (outcomes
+        only come at the end of a segment): in progress, and its share in %."""
+        task = self._monitoring(status)
+        if task is None or task.action_id is None:
+            return
+        record = self.store.action(task.action_id)
+        if record is None or record.state in TERMINAL:
+            return
+        running = []
+        for uav in self.scenario.fleet.uavs:
+            other = self.monitor.status(uav.id)
+            flown = self._monitoring(other) if other is not None else None
+            if flown is not None and flown.action_id == task.action_id:
+                running.append((flown, other.progress))
+        live = progress.live_monitor_progress(record, running)
+        if record.state != ActionState.IN_PROGRESS:
+            self._transition(record, ActionEvent.STARTED, f"{task.task_id} on station")
+            record = self._record(record.action_id)
+        if live - record.progress >= LIVE_PROGRESS_STEP:
+            self._save(msgspec.structs.replace(record, progress=live), record.state, "flying")
+
+    def _monitoring(self, status: AgentStatus) -> MonitorTask | None:
+        """The monitoring task ``status`` says is being flown, if any."""
+        plan = self.replanner.plans.get(status.uav_id)
+        if plan is None or status.state != AgentState.BUSY or status.progress <= 0:
+            return None
+        task = next((t for t in plan.tasks if t.task_id == status.task_id), None)
+        return task if isinstance(task, MonitorTask) else None
 
     def on_telemetry(self, telemetry: Telemetry) -> None:
-        """Replan once per plan if the battery is below the plan's estimate by a margin."""
+        """Note the tool carried; replan once per plan if the battery of a UAV
+        in flight is below the plan's estimate for its current task by a margin."""
+        if telemetry.tool is not None:
+            self._carried[telemetry.uav_id] = telemetry.tool
         plan = self.replanner.plans.get(telemetry.uav_id)
         uav_type = self.scenario.fleet.type_of(telemetry.uav_id)
         if not plan or not plan.tasks or uav_type is None:
             return
+        if isinstance(plan.tasks[0], RechargeTask) or telemetry.flight_state == FlightState.LANDED:
+            return  # charging, or drawing nothing on a pad: not a battery fault
         margin = self.battery_margin_fraction * uav_type.battery_wh
         if telemetry.battery_wh >= plan.tasks[0].energy_after_wh - margin:
             return
@@ -218,10 +378,9 @@ class MissionManager:
         self.replan(f"{telemetry.uav_id} battery below plan")
 
     def on_fleet_changes(self, changes: list[tuple[str, Change]]) -> None:
-        """A UAV was lost (after the grace) or came back: replan."""
+        """A UAV was lost (after the grace), crashed, or came back: replan."""
         for uav_id, change in changes:
-            kind = EventKind.UAV_LOST if change == Change.LOST else EventKind.UAV_BACK
-            self.events.emit(kind, uav_id=uav_id)
+            self.events.emit(FLEET_EVENTS[change], uav_id=uav_id, detail=FLEET_TEXT[change])
             if change == Change.BACK:
                 self.replanner.resend(uav_id)
         if changes:
@@ -270,6 +429,8 @@ class MissionManager:
                 action_id=record.action_id,
                 detail=f"{record.state}->{state}: {reason}",
             )
+            if state == ActionState.FAILED:
+                self.events.emit(EventKind.ACTION_FAILED, action_id=record.action_id, detail=reason)
 
     def _save(self, record: ActionRecord, previous: ActionState, reason: str) -> None:
         now = self.clock()

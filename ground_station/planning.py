@@ -12,24 +12,28 @@ leaves a UAV's work alone yields the same ids, and an agent keeps flying.
 from __future__ import annotations
 
 import dataclasses
+import itertools
 from collections.abc import Iterable
+
+import msgspec
 
 from ground_station import planner as pl
 from proto.fleet import Fleet
 from proto.geo import Point
-from proto.mission import Action, ActionRecord, DeliverAction, InspectAction, MonitorAction
+from proto.mission import ActionRecord, DeliverAction, InspectAction, MonitorAction
 from proto.plan import (
     DeliverTask,
     GoHomeTask,
     InspectTask,
     MonitorTask,
     PickTask,
+    Plan,
     RechargeTask,
     Task,
     WaitTask,
     Waypoint,
 )
-from proto.site import BatterySwap, ChargingStation, Site
+from proto.site import BatterySwap, ChargingStation, Safety, Site
 
 
 @dataclasses.dataclass(frozen=True)
@@ -45,8 +49,21 @@ class UavNow:
     running_action: str | None = None
 
 
-def _xyz(p: Point) -> tuple[float, float, float]:
-    return (p.x_m, p.y_m, p.z_m)
+PLANNING_MARGIN = 0.03
+"""Fraction of capacity the plans keep above the fleet's reserve. Agents
+judge "battery enough" with a safety factor (``energy_margin``) over the
+next step and the way to a station; a plan that ran to the bare reserve
+would make them leave a slot or skip a waypoint half a minute early, before
+the relief the plan sent. 3 % covers that factor on the paper's fleet."""
+TAKEOFF_LEAD_S = 8.0
+"""Seconds a UAV leaves early for a monitoring segment (arming, take-off, climb)."""
+DROP_HEIGHT_M = 2.0
+"""Height above the worker at which a tool is released (the agent's
+``deliver_height_m`` default)."""
+
+
+def _xyz(p: Point, above_m: float = 0.0) -> tuple[float, float, float]:
+    return (p.x_m, p.y_m, p.z_m + above_m)
 
 
 def build_problem(
@@ -56,13 +73,18 @@ def build_problem(
     records: Iterable[ActionRecord],
     now_s: float,
     worker_positions: dict[str, Point] | None = None,
+    monitor_starts: dict[str, float] | None = None,
 ) -> pl.Problem:
-    """The planner's view of the mission at ``now_s`` (mission seconds)."""
+    """The planner's view of the mission at ``now_s`` (mission seconds).
+    ``monitor_starts`` holds the synchronised starts (mission seconds)
+    already promised for monitoring actions; future ones are kept if feasible."""
     workers = {w.id: w.position for w in site.workers} | (worker_positions or {})
     specs = {u.id: u for u in fleet.uavs}
+    safety = site.safety
     return pl.Problem(
         now_s=0.0,
-        reserve_fraction=fleet.reserve_fraction,
+        reserve_fraction=min(1.0, fleet.reserve_fraction + PLANNING_MARGIN),
+        min_altitude_m=safety.ground_z_m + safety.min_altitude_m,
         stations=tuple(
             pl.Station(
                 id=s.id,
@@ -105,11 +127,19 @@ def build_problem(
             )
             for u in uavs
         ),
-        actions=tuple(_action(r, workers, now_s) for r in records),
+        actions=tuple(_action(r, workers, safety, now_s, monitor_starts or {}) for r in records),
     )
 
 
-def _action(record: ActionRecord, workers: dict[str, Point], now_s: float) -> pl.Action:
+def _action(
+    record: ActionRecord,
+    workers: dict[str, Point],
+    safety: Safety,
+    now_s: float,
+    monitor_starts: dict[str, float],
+) -> pl.Action:
+    """The planner's action; a delivery's ``worker_m`` is its drop point,
+    ``DROP_HEIGHT_M`` above the worker, where the agent releases the tool."""
     action = record.action
     common = {
         "id": record.action_id,
@@ -132,18 +162,37 @@ def _action(record: ActionRecord, workers: dict[str, Point], now_s: float) -> pl
                 worker_m=_xyz(workers[action.worker_id]),
                 k=action.uavs,
                 standoff_m=action.standoff_m,
+                height_m=safety.monitor_height_m,
                 duration_s=max(1.0, action.duration_s - record.monitored_s),
+                start_s=_promised(monitor_starts.get(record.action_id), now_s),
             )
         case DeliverAction():
             return pl.DeliverAction(
                 **common,
                 tool=action.tool,
                 tool_station=action.tool_station_id,
-                worker_m=_xyz(workers[action.worker_id]),
+                worker_m=_xyz(workers[action.worker_id], DROP_HEIGHT_M),
                 pick_s=action.pick_s,
                 drop_s=action.drop_s,
             )
     raise TypeError(f"unknown action {action!r}")
+
+
+def _promised(start_s: float | None, now_s: float) -> float | None:
+    """A promised start on the planner's clock, if it is still ahead."""
+    return start_s - now_s if start_s is not None and start_s > now_s else None
+
+
+def monitor_starts(plans: Iterable[Plan]) -> dict[str, float]:
+    """The synchronised start (mission seconds) of each monitoring action in
+    ``plans``: the earliest moment one of its segments begins on station."""
+    starts: dict[str, float] = {}
+    for plan in plans:
+        for task in plan.tasks:
+            if isinstance(task, MonitorTask) and task.action_id is not None:
+                begin = task.end_s - task.duration_s
+                starts[task.action_id] = min(begin, starts.get(task.action_id, begin))
+    return starts
 
 
 def to_tasks(
@@ -197,21 +246,40 @@ def to_tasks(
             )
             i = j + 1
             continue
-        tasks.append(_simple_task(step, action, uav_plan.uav_id, stations, capacity, counts, times))
+        tasks.append(
+            _simple_task(
+                step, record, uav_plan.uav_id, stations, site.safety, capacity, counts, times
+            )
+        )
         i += 1
-    return tasks
+    return _lead_departures(tasks)
+
+
+def _lead_departures(tasks: list[Task]) -> list[Task]:
+    """End each wait before a monitoring segment ``TAKEOFF_LEAD_S`` early
+    (never before the wait's start): the planner counts no time for
+    arming, take-off and climb, and a relief must be on station before the
+    UAV it relieves departs."""
+    out = list(tasks)
+    for i, (task, after) in enumerate(itertools.pairwise(tasks)):
+        if isinstance(task, WaitTask) and isinstance(after, MonitorTask):
+            until = max(task.start_s, task.until_s - TAKEOFF_LEAD_S)
+            out[i] = msgspec.structs.replace(task, until_s=until, end_s=until)
+    return out
 
 
 def _simple_task(
     step: pl.Step,
-    action: Action | None,
+    record: ActionRecord | None,
     uav_id: str,
     stations: dict[str, ChargingStation],
+    safety: Safety,
     capacity: float,
     counts: dict[str, int],
     times: dict[str, float],
 ) -> Task:
     """A wire task for a planner step other than inspect."""
+    action = record.action if record is not None else None
 
     def ordinal(kind: str) -> int:
         counts[kind] = counts.get(kind, 0) + 1
@@ -219,14 +287,16 @@ def _simple_task(
 
     match step.kind:
         case "monitor":
+            done = record.segments.get(uav_id, 0) if record is not None else 0
             return MonitorTask(
                 task_id=f"{step.action_id}.slot{step.index}.{uav_id}."
-                f"{ordinal('monitor:' + step.action_id)}",
+                f"{done + ordinal('monitor:' + step.action_id)}",
                 action_id=step.action_id,
                 worker_id=action.worker_id,
                 slot=step.index,
                 slots=action.uavs,
                 standoff_m=action.standoff_m,
+                height_m=safety.monitor_height_m,
                 duration_s=max(0.001, step.end_s - step.arrive_s),
                 **times,
             )

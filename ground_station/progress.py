@@ -2,8 +2,10 @@
 
 Inspection: the waypoint indices an agent reports as done are merged into
 the action; all done -> finished. Monitoring: a task's covered seconds
-(its duration times its reported progress) count for one of the ``k``
+(measured on board, at most its duration) count for one of the ``k``
 slots, so ``monitored_s`` grows by that share; full duration -> finished.
+Each ended segment bumps its UAV's segment count, so the next segment has
+a new task id.
 Delivery: the pick starts the action, the drop finishes it.
 """
 
@@ -38,10 +40,14 @@ def apply_outcome(
                 return record, ActionEvent.FINISHED
             return record, ActionEvent.STARTED if reported else None
         case (MonitorTask(duration_s=duration, slots=slots), MonitorAction(duration_s=total)):
-            covered = duration * (1.0 if completed else outcome.progress) / slots
+            flown = outcome.flown_s or duration * (1.0 if completed else outcome.progress)
+            covered = min(flown, duration) / slots
             monitored = min(total, record.monitored_s + covered)
+            segments = dict(record.segments)
+            if covered > 0 or completed:
+                segments[outcome.uav_id] = segments.get(outcome.uav_id, 0) + 1
             record = msgspec.structs.replace(
-                record, monitored_s=monitored, progress=monitored / total
+                record, monitored_s=monitored, progress=monitored / total, segments=segments
             )
             if monitored >= total - _EPS_S:
                 return record, ActionEvent.FINISHED
@@ -51,3 +57,13 @@ def apply_outcome(
         case (DeliverTask(), _) if completed:
             return msgspec.structs.replace(record, progress=1.0), ActionEvent.FINISHED
     return record, None
+
+
+def live_monitor_progress(record: ActionRecord, running: list[tuple[MonitorTask, float]]) -> float:
+    """The action's progress counting the flown share of the segments being
+    flown now (each ``(task, its progress)`` from the agents' statuses)."""
+    action = record.action
+    if not isinstance(action, MonitorAction):
+        return record.progress
+    covered = sum(task.duration_s * share / task.slots for task, share in running)
+    return min(1.0, (record.monitored_s + covered) / action.duration_s)

@@ -6,18 +6,21 @@ from __future__ import annotations
 
 import dataclasses
 import logging
+import math
 import time
 from collections.abc import Callable
+
+import msgspec
 
 from ground_station import planner as pl
 from ground_station.event_log import EventLog
 from ground_station.fleet_monitor import FleetMonitor
 from ground_station.lifecycle import ActionEvent
-from ground_station.planning import UavNow, build_problem, same_work, to_tasks
+from ground_station.planning import UavNow, build_problem, monitor_starts, same_work, to_tasks
 from ground_station.store import Store
 from proto.events import EventKind
 from proto.mission import ActionRecord
-from proto.plan import DeliverTask, MonitorTask, Plan
+from proto.plan import DeliverTask, GoHomeTask, MonitorTask, Plan
 from proto.scenario import Scenario
 from proto.telemetry import FlightState
 
@@ -25,6 +28,9 @@ log = logging.getLogger(__name__)
 
 IMPOSSIBLE = frozenset({"unreachable_with_full_battery", "unknown_tool"})
 """Unplaced reasons that no change of fleet state can cure: the action fails."""
+
+ON_PAD_M = 1.0
+"""A landed UAV this close (horizontally) to a station is on its pad."""
 
 AIRBORNE = frozenset({FlightState.FLYING, FlightState.TAKING_OFF, FlightState.LANDING})
 
@@ -47,6 +53,7 @@ class ReplanStats:
     total_s: float = 0.0
     last_s: float = 0.0
     plans_sent: int = 0
+    unchanged: int = 0  # replans that changed no UAV's plan (no event, no epoch)
 
 
 class Replanner:
@@ -76,11 +83,26 @@ class Replanner:
         """Give ``uav_id`` a fresh plan (higher epoch) at the next replan."""
         self._resend.add(uav_id)
 
+    def finished(self, uav_id: str, task_id: str) -> None:
+        """``task_id`` ended on ``uav_id``: drop it (and what preceded it) from
+        the plan held for the UAV, as the agent dropped it from its queue. The
+        epoch stays: the agent's queue and this plan still agree."""
+        plan = self.plans.get(uav_id)
+        if plan is None:
+            return
+        ids = [t.task_id for t in plan.tasks]
+        if task_id in ids:
+            rest = plan.tasks[ids.index(task_id) + 1 :]
+            self.plans[uav_id] = msgspec.structs.replace(plan, tasks=rest)
+
     def replan(self, records: list[ActionRecord], now_s: float, reason: str) -> ReplanOutcome:
         """Plan ``records`` (the actions in force) from the fleet's state now."""
         site, fleet = self.scenario.site, self.scenario.fleet
         in_force = {r.action_id for r in records}
-        problem = build_problem(site, fleet, self._uavs_now(in_force), records, now_s)
+        starts = monitor_starts(self.plans.values())
+        problem = build_problem(
+            site, fleet, self._uavs_now(in_force), records, now_s, monitor_starts=starts
+        )
         started = time.perf_counter()
         try:
             result = pl.plan(problem, self.options)
@@ -90,7 +112,10 @@ class Replanner:
             return ReplanOutcome(self.store.counter("epoch"), [], {}, 0.0)
         elapsed = time.perf_counter() - started
         by_id = {r.action_id: r for r in records}
-        new_tasks = {up.uav_id: to_tasks(up, site, fleet, by_id, now_s) for up in result.uavs}
+        new_tasks = {
+            up.uav_id: self._drop_done_home(up.uav_id, to_tasks(up, site, fleet, by_id, now_s))
+            for up in result.uavs
+        }
         changed_ids = [
             u.id
             for u in fleet.uavs
@@ -120,12 +145,31 @@ class Replanner:
         self.stats.count += 1
         self.stats.total_s += elapsed
         self.stats.last_s = elapsed
-        self.events.emit(
-            EventKind.REPLAN,
-            epoch=epoch,
-            detail=f"{reason}; {len(changed)} plan(s) changed in {elapsed * 1e3:.1f} ms",
-        )
+        if not changed:  # counted in /metrics, not worth an event
+            self.stats.unchanged += 1
+        else:
+            self.events.emit(
+                EventKind.REPLAN,
+                epoch=epoch,
+                detail=f"{reason}; {len(changed)} plan(s) changed in {elapsed * 1e3:.1f} ms",
+            )
         return ReplanOutcome(epoch, changed, _action_events(records, new_tasks, result), elapsed)
+
+    def _drop_done_home(self, uav_id: str, tasks: list) -> list:
+        """A plan that only sends a UAV to the pad it already sits on asks
+        nothing: it is empty (else the agent would "complete" it at once,
+        over and over)."""
+        telemetry = self.monitor.telemetry(uav_id)
+        if len(tasks) != 1 or not isinstance(tasks[0], GoHomeTask) or telemetry is None:
+            return tasks
+        station = self.scenario.site.station(tasks[0].station_id)
+        p = telemetry.position
+        on_pad = (
+            telemetry.flight_state == FlightState.LANDED
+            and station is not None
+            and math.hypot(p.x_m - station.position.x_m, p.y_m - station.position.y_m) <= ON_PAD_M
+        )
+        return [] if on_pad else tasks
 
     def _tasks(self, uav_id: str) -> list:
         plan = self.plans.get(uav_id)

@@ -33,8 +33,12 @@ def main(argv: list[str] | None = None) -> int:
         log.error("router cannot start: %s", exc)
         return 1
     with bus:
-        bus.declare_token(KeySpace(args.site).alive(Role.ROUTER, args.id))
-        log.info("router listening on %s", ", ".join(config.listen), extra={"site": args.site})
+        bus.declare_token(KeySpace(args.site or "default").alive(Role.ROUTER, args.id))
+        log.info(
+            "router listening on %s",
+            ", ".join(config.listen),
+            extra={"site": args.site or "default"},
+        )
         shutdown.wait()
         log.info("router stopping on %s", shutdown.signal_name or "request")
     return 0

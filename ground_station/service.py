@@ -114,6 +114,8 @@ class GroundStation:
 
     def _on_status(self, _key: str, status: AgentStatus) -> None:
         self.monitor.on_status(status)
+        if self.monitor.known(status.uav_id):
+            self.manager.on_status(status)
 
     def _on_outcome(self, _key: str, outcome: TaskOutcome) -> None:
         if self.monitor.known(outcome.uav_id):
@@ -154,6 +156,7 @@ class GroundStation:
             "replan_seconds_total": stats.total_s,
             "replan_seconds_last": stats.last_s,
             "plans_sent": stats.plans_sent,
+            "replans_unchanged": stats.unchanged,
             "outcomes": counters.outcomes,
             "stale_outcomes": counters.stale_outcomes,
             "battery_replans": counters.battery_replans,

@@ -1,5 +1,11 @@
 """Checks an operator action against the site and the fleet before it is
-accepted. Every failure is an :class:`InvalidAction` naming the field."""
+accepted. Every failure is an :class:`InvalidAction` naming the field.
+
+Physically absurd requests are refused here, not discovered in flight:
+targets below the site's minimum flight altitude or outside its area, a
+monitoring slot closer to the worker than the people clearance, and a
+monitoring duration longer than the capable fleet could cover even with
+hand-overs and recharges."""
 
 from __future__ import annotations
 
@@ -36,13 +42,26 @@ def validate(action: Action, site: Site, fleet: Fleet, field: str = "action") ->
                     "an inspection needs at least one waypoint", field=f"{field}.waypoints"
                 )
             for i, waypoint in enumerate(waypoints):
-                _check_position(waypoint.position, f"{field}.waypoints[{i}].position")
+                _check_position(waypoint.position, f"{field}.waypoints[{i}].position", site)
             _need(fleet, Capability.INSPECT, 1, field)
         case MonitorAction(worker_id=worker_id, uavs=k):
             _worker(site, worker_id, field)
             _need(fleet, Capability.MONITOR, k, f"{field}.uavs")
             if action.duration_s > MAX_DURATION_S:
                 raise InvalidAction("duration over a week", field=f"{field}.duration_s")
+            clearance = site.safety.people_clearance_m
+            if math.hypot(action.standoff_m, site.safety.monitor_height_m) < clearance:
+                raise InvalidAction(
+                    f"the slot would be closer than {clearance:g} m to the worker",
+                    field=f"{field}.standoff_m",
+                )
+            longest = coverable_s(site, fleet, k)
+            if action.duration_s > longest:
+                raise InvalidAction(
+                    f"{k} UAV(s) cannot cover {action.duration_s:.0f} s even with hand-overs "
+                    f"(at most about {longest:.0f} s with this fleet)",
+                    field=f"{field}.duration_s",
+                )
         case DeliverAction():
             station = site.tool_station(action.tool_station_id)
             if station is None:
@@ -81,11 +100,76 @@ def _need(fleet: Fleet, capability: Capability, count: int, field: str) -> None:
         )
 
 
-def _check_position(position: Any, field: str) -> None:
-    if max(abs(position.x_m), abs(position.y_m)) > MAX_RANGE_M:
+def _check_position(position: Any, field: str, site: Site) -> None:
+    safety = site.safety
+    floor = safety.ground_z_m + safety.min_altitude_m
+    if position.z_m < floor:
+        raise InvalidAction(
+            f"z {position.z_m:g} m is below the minimum flight altitude {floor:g} m "
+            f"({safety.min_altitude_m:g} m above the ground at {safety.ground_z_m:g} m)",
+            field=f"{field}.z_m",
+        )
+    if position.z_m > MAX_ALTITUDE_M:
+        raise InvalidAction(f"z above {MAX_ALTITUDE_M:.0f} m", field=f"{field}.z_m")
+    box = _area(site)
+    if box is not None:
+        (x0, y0), (x1, y1) = box
+        if not (x0 <= position.x_m <= x1 and y0 <= position.y_m <= y1):
+            raise InvalidAction(
+                f"outside the site's area (x {x0:g}..{x1:g}, y {y0:g}..{y1:g} m)", field=field
+            )
+    elif max(abs(position.x_m), abs(position.y_m)) > MAX_RANGE_M:
         raise InvalidAction(f"more than {MAX_RANGE_M:.0f} m from the site", field=field)
-    if not -100.0 <= position.z_m <= MAX_ALTITUDE_M:
-        raise InvalidAction(f"altitude outside -100..{MAX_ALTITUDE_M:.0f} m", field=field)
+
+
+def _area(site: Site) -> tuple[tuple[float, float], tuple[float, float]] | None:
+    """The box around the site's features, widened by ``area_margin_m``."""
+    points = [
+        *(t.position for t in site.towers),
+        *(s.position for s in site.stations),
+        *(t.position for t in site.tool_stations),
+        *(w.position for w in site.workers),
+    ]
+    if not points:
+        return None
+    m = site.safety.area_margin_m
+    xs, ys = [p.x_m for p in points], [p.y_m for p in points]
+    return (min(xs) - m, min(ys) - m), (max(xs) + m, max(ys) + m)
+
+
+def coverable_s(site: Site, fleet: Fleet, k: int) -> float:
+    """An upper bound on how long ``k`` slots can be watched without a gap.
+
+    Each monitor-capable UAV hovers ``E`` seconds per charge (usable energy
+    over hover power) and then needs ``R`` seconds on the fastest pad, so in
+    the long run it covers at most ``E / (E + R)`` of the time. If those
+    shares add up to ``k`` or more the bound is infinite; otherwise over a
+    duration ``D`` the fleet has ``sum(E) + D * sum(share)`` seconds of
+    hovering for the ``k * D`` needed: ``D <= sum(E) / (k - sum(share))``.
+    Transit is ignored, so the bound never refuses a feasible request.
+    """
+    recharge_s = (
+        min(
+            (getattr(s.recharge, "swap_s", None) or getattr(s.recharge, "full_charge_s", 0.0))
+            for s in site.stations
+        )
+        if site.stations
+        else math.inf
+    )
+    types = {t.name: t for t in fleet.types}
+    endurance, share = 0.0, 0.0
+    for uav in fleet.uavs:
+        t = types[uav.type]
+        if Capability.MONITOR not in t.capabilities:
+            continue
+        if t.hover_power_w <= 0:
+            return math.inf
+        e_s = t.battery_wh * (1.0 - fleet.reserve_fraction) * 3600.0 / t.hover_power_w
+        endurance += e_s
+        share += e_s / (e_s + recharge_s) if math.isfinite(recharge_s) else 0.0
+    if share >= k:
+        return math.inf
+    return endurance / (k - share)
 
 
 def _check_numbers(value: Any, field: str) -> None:

@@ -17,7 +17,9 @@ from linecrew.logs import configure_logging
 def common_parser(prog: str, description: str) -> argparse.ArgumentParser:
     """An argument parser with the flags every process takes."""
     parser = argparse.ArgumentParser(prog=prog, description=description)
-    parser.add_argument("--site", default="default", help="site id (key space root)")
+    parser.add_argument(
+        "--site", help="site id (key space root); must match the scenario's if both are given"
+    )
     parser.add_argument(
         "--connect", action="append", help="zenoh endpoint to connect to (repeatable)"
     )

@@ -3,9 +3,10 @@ station with the reserve, and is there even enough to reach one now?
 
 "The next step" is the part of the head task up to its next checkpoint: the
 next inspection waypoint with its service time, the next
-``MONITOR_LOOKAHEAD_S`` of monitoring (a long watch is not one step: the UAV
-keeps its slot while it can and leaves for a station when it must, and the
-ground station hands the slot over), the leg to the tool station or the
+``MONITOR_LOOKAHEAD_S`` of monitoring, never past the segment's planned end
+(a long watch is not one step: the UAV keeps its slot while it can and
+leaves for a station when it must, and the ground station hands the slot
+over at the planned end), the leg to the tool station or the
 worker, the leg to the station of a recharge / go-home task, or hovering
 until a wait ends when airborne.
 """
@@ -56,7 +57,9 @@ def step_wh(ctx: Context) -> tuple[float, Point]:
         case MonitorTask(duration_s=duration):
             slot = targets.monitor_slot(ctx) or here
             left = duration - ctx.mission.monitored_s(task.task_id)
-            look_ahead = min(left, MONITOR_LOOKAHEAD_S)
+            if task.end_s > 0:  # a planned window: the plan says when to leave
+                left = min(left, task.end_s - ctx.wall())
+            look_ahead = max(0.0, min(left, MONITOR_LOOKAHEAD_S))
             return energy.travel_wh(here, slot) + energy.hover_wh(look_ahead), slot
         case PickTask(pick_s=service) | DeliverTask(drop_s=service):
             point = (targets.pick_point if isinstance(task, PickTask) else targets.drop_point)(ctx)

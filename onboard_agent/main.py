@@ -60,7 +60,7 @@ def main(argv: list[str] | None = None) -> int:
     bus_config = start(args, "agent")
     try:
         config = AgentConfig.from_env(tick_hz=args.tick_hz, agent_link_timeout_s=args.link_timeout)
-        scenario = scenarios.load(args.scenario)
+        scenario = scenarios.load(args.scenario, site=args.site)
     except (ValueError, LinecrewError) as exc:
         log.error("cannot start: %s", exc)
         return 2
@@ -75,7 +75,7 @@ def main(argv: list[str] | None = None) -> int:
                 bus_config,
                 config,
                 stop,
-                args.site,
+                scenario.site.id,
                 args.speedup,
             )
         )

@@ -175,6 +175,7 @@ class Mission:
             progress=self.progress(task) if progress is None else progress,
             waypoints_done=self.waypoints_done(task.task_id),
             stamp_s=self.wall(),
+            flown_s=self.monitored_s(task.task_id),
         )
         log.info("task %s %s %s", task.task_id, result, reason, extra={"uav_id": self.uav_id})
         self.outbox.append(outcome)

@@ -52,8 +52,16 @@ def waypoint(ctx: Context) -> Point | None:
     return wp.position if wp is not None else None
 
 
+def _safe(ctx: Context, point: Point) -> Point:
+    """``point`` raised to the site's minimum flight altitude if below it."""
+    safety = ctx.surroundings.site.safety
+    floor = safety.ground_z_m + safety.min_altitude_m
+    return point if point.z_m >= floor else Point(x_m=point.x_m, y_m=point.y_m, z_m=floor)
+
+
 def monitor_slot(ctx: Context) -> Point | None:
-    """Slot ``slot`` of ``slots`` on a circle of ``standoff_m`` around the worker."""
+    """Slot ``slot`` of ``slots`` on a circle of ``standoff_m`` around the
+    worker, ``height_m`` above them (never at a person's own height)."""
     task = ctx.mission.head
     if not isinstance(task, MonitorTask):
         return None
@@ -61,11 +69,12 @@ def monitor_slot(ctx: Context) -> Point | None:
     if worker is None:
         return None
     angle = 2 * math.pi * task.slot / task.slots
-    return Point(
+    slot = Point(
         x_m=worker.x_m + task.standoff_m * math.cos(angle),
         y_m=worker.y_m + task.standoff_m * math.sin(angle),
-        z_m=worker.z_m,
+        z_m=worker.z_m + task.height_m,
     )
+    return _safe(ctx, slot)
 
 
 def drop_point(ctx: Context) -> Point | None:
@@ -74,7 +83,7 @@ def drop_point(ctx: Context) -> Point | None:
     if not isinstance(task, DeliverTask):
         return None
     worker = ctx.surroundings.worker_position(task.worker_id)
-    return _above(worker, ctx.config.deliver_height_m) if worker is not None else None
+    return _safe(ctx, _above(worker, ctx.config.deliver_height_m)) if worker is not None else None
 
 
 def pick_point(ctx: Context) -> Point | None:

@@ -16,8 +16,11 @@ class EventKind(enum.StrEnum):
     ACTION_STATE = "action_state"
     PLAN_CHANGED = "plan_changed"
     REPLAN = "replan"
+    ACTION_FAILED = "action_failed"
+    HANDOVER = "handover"
     UAV_LOST = "uav_lost"
     UAV_BACK = "uav_back"
+    UAV_CRASHED = "uav_crashed"
     UAV_STATE = "uav_state"
     FAULT = "fault"
 

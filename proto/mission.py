@@ -70,7 +70,9 @@ class ActionRecord(Record, frozen=True, kw_only=True):
 
     Partial progress: ``waypoints_done`` (inspection waypoint indices already
     inspected, so a split inspection resumes) and ``monitored_s`` (seconds of
-    monitoring already covered).
+    monitoring already covered). ``segments`` counts the monitoring segments
+    each UAV has ended, so that a later segment gets a new task id and is
+    never mistaken for the one already flown.
     """
 
     action_id: Id
@@ -83,3 +85,4 @@ class ActionRecord(Record, frozen=True, kw_only=True):
     request_id: str | None = None
     waypoints_done: list[int] = []
     monitored_s: NonNegative = 0.0
+    segments: dict[str, int] = {}

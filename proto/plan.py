@@ -38,14 +38,16 @@ class InspectTask(TaskBase, frozen=True, kw_only=True, tag="inspect"):
 
 
 class MonitorTask(TaskBase, frozen=True, kw_only=True, tag="monitor"):
-    """Hold slot ``slot`` of ``slots`` around the worker at ``standoff_m``,
-    following them, for ``duration_s``."""
+    """Hold slot ``slot`` of ``slots`` around the worker (``standoff_m``
+    away horizontally, ``height_m`` above them), following them, for
+    ``duration_s``."""
 
     worker_id: Id
     slot: Count
     slots: PositiveCount
     standoff_m: Positive
     duration_s: Positive
+    height_m: NonNegative = 3.0
 
 
 class PickTask(TaskBase, frozen=True, kw_only=True, tag="pick"):

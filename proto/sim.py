@@ -95,6 +95,23 @@ class DeliveryRecord(Record, frozen=True, kw_only=True):
     sim_time_s: float
 
 
+class SafetyViolation(Record, frozen=True, kw_only=True):
+    """Something the simulator saw that must never happen.
+
+    ``kind``: ``ground_contact`` (touched the ground while flying, away from a
+    controlled landing: a crash), ``off_pad_landing`` (landed away from every
+    charging pad), ``people_proximity`` (airborne within the site's
+    ``people_clearance_m`` of a worker), ``separation`` (two airborne UAVs
+    closer than ``separation_m``). One record each time a condition begins.
+    """
+
+    kind: str
+    uav_id: Id
+    sim_time_s: float
+    position: Point
+    detail: str = ""
+
+
 class VehicleTruth(Record, frozen=True, kw_only=True):
     """A vehicle as the simulator knows it."""
 
@@ -114,3 +131,4 @@ class SimState(Message, frozen=True, kw_only=True):
     speedup: float
     vehicles: list[VehicleTruth] = []
     deliveries: list[DeliveryRecord] = []
+    violations: list[SafetyViolation] = []

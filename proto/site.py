@@ -5,7 +5,7 @@ stations, workers. Positions are local ENU metres (see :mod:`proto.geo`).
 
 from __future__ import annotations
 
-from proto.base import Count, Id, Message, NonNegative, Positive, Record
+from proto.base import Count, Id, Message, NonNegative, Positive, PositiveCount, Record
 from proto.geo import GeoPoint, Point
 
 
@@ -49,10 +49,11 @@ class ChargingStation(Record, frozen=True, kw_only=True):
 
 
 class Tool(Record, frozen=True, kw_only=True):
-    """A tool a gripper UAV can carry."""
+    """A tool a gripper UAV can carry; the station holds ``count`` of them."""
 
     name: Id
     mass_kg: NonNegative = 0.0
+    count: PositiveCount = 1
 
 
 class ToolStation(Record, frozen=True, kw_only=True):
@@ -61,6 +62,10 @@ class ToolStation(Record, frozen=True, kw_only=True):
     id: Id
     position: Point
     tools: list[Tool] = []
+
+    def stock(self, tool: str) -> int:
+        """How many ``tool`` the station holds at the start of a mission."""
+        return sum(t.count for t in self.tools if t.name == tool)
 
 
 class TimedPoint(Record, frozen=True, kw_only=True):
@@ -80,6 +85,26 @@ class Worker(Record, frozen=True, kw_only=True):
     path: list[TimedPoint] = []
 
 
+class Safety(Record, frozen=True, kw_only=True):
+    """The site's safe-geometry rules, in metres (flat ground at ``ground_z_m``).
+
+    Every target a UAV is flown to (inspection waypoints, monitoring slots,
+    pick and drop points) keeps at least ``min_altitude_m`` above the ground;
+    a monitoring slot is ``monitor_height_m`` above the worker (at the
+    action's horizontal stand-off); no UAV comes closer to a person than
+    ``people_clearance_m`` (3-D) nor to another UAV than ``separation_m``.
+    Take-off and landing happen on pads only. Targets farther than
+    ``area_margin_m`` outside the box around the site's features are refused.
+    """
+
+    ground_z_m: float = 0.0
+    min_altitude_m: NonNegative = 2.0
+    monitor_height_m: NonNegative = 3.0
+    people_clearance_m: NonNegative = 1.5
+    separation_m: NonNegative = 1.0
+    area_margin_m: NonNegative = 200.0
+
+
 class Site(Message, frozen=True, kw_only=True):
     """Everything static about a work site."""
 
@@ -90,6 +115,7 @@ class Site(Message, frozen=True, kw_only=True):
     stations: list[ChargingStation] = []
     tool_stations: list[ToolStation] = []
     workers: list[Worker] = []
+    safety: Safety = Safety()
 
     def station(self, station_id: str) -> ChargingStation | None:
         """The charging station with this id, if any."""
@@ -110,6 +136,7 @@ __all__ = [
     "ChargingStation",
     "Line",
     "RechargeModel",
+    "Safety",
     "Site",
     "Tool",
     "ToolStation",

@@ -75,7 +75,9 @@ class TaskOutcome(Message, frozen=True, kw_only=True):
 
     ``epoch`` is the plan epoch the task came from (stale epochs are recorded
     but change nothing). ``waypoints_done`` lists inspection waypoint indices
-    visited, so a split inspection resumes where it stopped.
+    visited, so a split inspection resumes where it stopped. ``flown_s`` is
+    the time spent on station for a monitoring task, measured on board: the
+    ground station credits that, not the planned duration.
     """
 
     uav_id: Id
@@ -87,6 +89,7 @@ class TaskOutcome(Message, frozen=True, kw_only=True):
     progress: Fraction = 1.0
     waypoints_done: list[int] = []
     stamp_s: float = 0.0
+    flown_s: NonNegative = 0.0
 
 
 class HumanPose(Message, frozen=True, kw_only=True):

@@ -5,7 +5,8 @@ Public API (import from here):
 - ``Scenario`` and its parts (``scenario``): the site and fleet to simulate;
   ``scenario_from_proto()`` builds one from a shared ``proto`` site and fleet.
 - ``World``: vehicles, charging stations, tool stations, workers; ``step(dt_s)``
-  on an injected clock; fault operations; ``deliveries`` (ground truth).
+  on an injected clock; fault operations; ``deliveries`` and ``violations``
+  (ground truth, see ``safety``).
 - ``Fleet`` / ``FleetConfig`` / ``FleetThread``: the runner that owns the world
   and one UDP MAVLink endpoint per vehicle (vehicle i on ``base_port + i``).
 """
@@ -17,11 +18,13 @@ from sim_fleet.fleet import Fleet, FleetConfig, FleetThread
 from sim_fleet.from_proto import scenario_from_proto
 from sim_fleet.geo import GeoFrame
 from sim_fleet.modes import FlightState, Mode
+from sim_fleet.safety import Violation
 from sim_fleet.scenario import (
     Capability,
     GeoOrigin,
     InteractionRules,
     RechargeModel,
+    SafetyRules,
     Scenario,
     StationSpec,
     ToolSpec,
@@ -53,6 +56,7 @@ __all__ = [
     "Outcome",
     "RechargeModel",
     "Result",
+    "SafetyRules",
     "Scenario",
     "Severity",
     "StationSpec",
@@ -63,6 +67,7 @@ __all__ = [
     "Vehicle",
     "VehicleSpec",
     "VehicleType",
+    "Violation",
     "WorkerSpec",
     "World",
     "scenario_from_proto",

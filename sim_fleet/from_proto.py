@@ -13,6 +13,7 @@ from sim_fleet.scenario import (
     GeoOrigin,
     InteractionRules,
     RechargeModel,
+    SafetyRules,
     Scenario,
     StationSpec,
     ToolSpec,
@@ -32,6 +33,19 @@ def _recharge(model: proto.RechargeModel) -> RechargeModel:
     if isinstance(model, proto.BatterySwap):
         return RechargeModel(kind="swap", swap_s=model.swap_s)
     return RechargeModel(kind="charge", full_charge_s=model.full_charge_s)
+
+
+def _safety(s: proto.Safety) -> SafetyRules:
+    if s.ground_z_m != 0.0:
+        raise ValueError(f"the simulator's ground is at z = 0, not {s.ground_z_m}")
+    return SafetyRules(people_clearance_m=s.people_clearance_m, separation_m=s.separation_m)
+
+
+def _tools(t: proto.ToolStation) -> tuple[ToolSpec, ...]:
+    """``count`` copies of each tool."""
+    return tuple(
+        ToolSpec(id=tool.name, mass_kg=tool.mass_kg) for tool in t.tools for _ in range(tool.count)
+    )
 
 
 def _vehicle_type(t: proto.UavType) -> VehicleType:
@@ -73,13 +87,10 @@ def scenario_from_proto(
             for s in site.stations
         ),
         tool_stations=tuple(
-            ToolStationSpec(
-                id=t.id,
-                position=_vec(t.position),
-                tools=tuple(ToolSpec(id=tool.name, mass_kg=tool.mass_kg) for tool in t.tools),
-            )
+            ToolStationSpec(id=t.id, position=_vec(t.position), tools=_tools(t))
             for t in site.tool_stations
         ),
         workers=tuple(WorkerSpec(id=w.id, position=_vec(w.position)) for w in site.workers),
         rules=rules or InteractionRules(),
+        safety=_safety(site.safety),
     )

@@ -79,7 +79,7 @@ def main(argv: list[str] | None = None) -> int:
     bus_config = start(args, "sim")
     shutdown = Shutdown().install()
     try:
-        scenario = load(args.scenario)
+        scenario = load(args.scenario, site=args.site)
         bus = Bus.open(bus_config, should_stop=shutdown.is_set)
     except (ScenarioError, Unavailable) as exc:
         log.error("simulator cannot start: %s", exc)

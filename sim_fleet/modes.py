@@ -28,7 +28,7 @@ class FlightState(StrEnum):
     FLYING = "flying"
     LANDING = "landing"
     FALLING = "falling"  # motors stopped in the air
-    CRASHED = "crashed"  # hit the ground falling; stays there
+    CRASHED = "crashed"  # hit the ground falling or flying; stays there
 
 
 # MAV_LANDED_STATE

@@ -129,6 +129,15 @@ class InteractionRules:
 
 
 @dataclass(frozen=True, kw_only=True)
+class SafetyRules:
+    """Distances the simulator watches for violations (metres, 3-D); the
+    defaults are ``proto.Safety``'s."""
+
+    people_clearance_m: float = 1.5  # no airborne UAV closer to a worker
+    separation_m: float = 1.0  # no two airborne UAVs closer to each other
+
+
+@dataclass(frozen=True, kw_only=True)
 class Scenario:
     """Everything the simulator needs to build a world."""
 
@@ -140,6 +149,7 @@ class Scenario:
     tool_stations: tuple[ToolStationSpec, ...] = ()
     workers: tuple[WorkerSpec, ...] = ()
     rules: InteractionRules = field(default_factory=InteractionRules)
+    safety: SafetyRules = field(default_factory=SafetyRules)
 
     def __post_init__(self) -> None:
         station_ids = {s.id for s in self.stations}

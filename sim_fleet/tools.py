@@ -64,14 +64,12 @@ def within_grab_reach(pos: Vec3, station: ToolStation, rules: InteractionRules) 
 
 
 def station_in_reach(
-    pos: Vec3, stations: list[ToolStation], rules: InteractionRules, *, with_tools: bool
+    pos: Vec3, stations: list[ToolStation], rules: InteractionRules
 ) -> ToolStation | None:
-    """The nearest tool station in grab reach (optionally: that still holds a tool)."""
+    """The nearest tool station in grab reach, empty or not."""
     best: ToolStation | None = None
     best_d = float("inf")
     for s in stations:
-        if with_tools and not s.tools:
-            continue
         if within_grab_reach(pos, s, rules):
             d = horizontal_distance(pos, s.position)
             if d < best_d:

@@ -3,20 +3,24 @@
 from __future__ import annotations
 
 from proto.geo import Point
-from proto.sim import DeliveryRecord, SimState, VehicleTruth
+from proto.sim import DeliveryRecord, SafetyViolation, SimState, VehicleTruth
+from sim_fleet.scenario import Vec3
 from sim_fleet.world import World
 
 
+def _point(p: Vec3) -> Point:
+    return Point(x_m=p[0], y_m=p[1], z_m=p[2])
+
+
 def sim_state(world: World, speedup: float) -> SimState:
-    """Vehicles and deliveries of ``world`` now."""
+    """Vehicles, deliveries and safety violations of ``world`` now."""
     vehicles = []
     for vehicle in world.vehicles.values():
         docked = world.station_status(vehicle.id)
-        x, y, z = vehicle.position
         vehicles.append(
             VehicleTruth(
                 uav_id=vehicle.id,
-                position=Point(x_m=x, y_m=y, z_m=z),
+                position=_point(vehicle.position),
                 battery_fraction=min(1.0, max(0.0, vehicle.battery.soc)),
                 state=str(vehicle.state.name).lower(),
                 armed=vehicle.armed,
@@ -30,6 +34,20 @@ def sim_state(world: World, speedup: float) -> SimState:
         )
         for d in world.deliveries
     ]
+    violations = [
+        SafetyViolation(
+            kind=v.kind,
+            uav_id=v.vehicle_id,
+            sim_time_s=v.time_s,
+            position=_point(v.position),
+            detail=v.detail,
+        )
+        for v in world.violations
+    ]
     return SimState(
-        sim_time_s=world.time_s, speedup=speedup, vehicles=vehicles, deliveries=deliveries
+        sim_time_s=world.time_s,
+        speedup=speedup,
+        vehicles=vehicles,
+        deliveries=deliveries,
+        violations=violations,
     )

@@ -251,7 +251,7 @@ class Vehicle:
                 self.state = FlightState.FLYING
         self._update_heading()
         if self.position[2] <= 0.0 and self.state is FlightState.FLYING:
-            self._touchdown()
+            self._crash()  # flown into the ground: only LAND and RTL touch down
 
     def _descend(self, dt_s: float) -> None:
         final = self.position[2] <= self.params.land_final_alt_m
@@ -310,6 +310,9 @@ class Vehicle:
         self.position = (self.position[0], self.position[1], 0.0)
         self.velocity = (0.0, 0.0, 0.0)
         self.state = FlightState.CRASHED
+        self.target = None
+        self.velocity_cmd = None
+        self.battery.load_w = 0.0
         self.armed = False
         self.say(Severity.EMERGENCY, "Crash: Disarming")
 

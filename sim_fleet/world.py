@@ -6,6 +6,7 @@ so the trajectory is the same whatever the speed-up or the caller's tick.
 Nothing here reads a clock or sleeps; the runner (``fleet``) or a test decides
 how much time passes. Fault operations are plain methods on the
 world and its vehicles so the later Zenoh fault service only has to call them.
+``deliveries``, ``drops`` and ``violations`` are the ground truth of outcomes.
 """
 
 from __future__ import annotations
@@ -17,6 +18,7 @@ from sim_fleet import physics
 from sim_fleet.events import Severity
 from sim_fleet.geo import GeoFrame
 from sim_fleet.modes import FlightState
+from sim_fleet.safety import SafetyMonitor, Violation
 from sim_fleet.scenario import Scenario, Vec3
 from sim_fleet.stations import ChargingStation
 from sim_fleet.tools import Delivery, Drop, ToolStation, station_in_reach, worker_in_reach
@@ -53,6 +55,13 @@ class World:
         self.workers: dict[str, Vec3] = {w.id: w.position for w in scenario.workers}
         self.deliveries: list[Delivery] = []
         self.drops: list[Drop] = []
+        pads = (s.position for s in scenario.stations)
+        self.safety = SafetyMonitor(scenario.safety, pads, self.rules.dock_radius_m)
+
+    @property
+    def violations(self) -> list[Violation]:
+        """Safety violations so far, in order (ground truth, see ``safety``)."""
+        return self.safety.violations
 
     def vehicle(self, vehicle_id: str) -> Vehicle:
         return self.vehicles[vehicle_id]
@@ -69,7 +78,11 @@ class World:
         for _ in range(n):
             self.time_s += h
             for v in self.vehicles.values():
+                before = v.state
                 v.step(h, self.time_s)
+                if v.state is not before:
+                    self.safety.transition(v, before, self.time_s)
+            self.safety.check(self.vehicles.values(), self.workers, self.time_s)
             self._recharge(h)
 
     def _recharge(self, dt_s: float) -> None:
@@ -100,6 +113,7 @@ class World:
 
     # ---- gripper (ToolHooks) ----------------------------------------------
     def grab(self, vehicle: Vehicle) -> str:
+        """Take a tool from the nearest tool station in reach (nothing if it is empty)."""
         if vehicle.holding is not None:
             return f"Gripper: already holding {vehicle.holding.id}"
         landed = vehicle.state is FlightState.LANDED
@@ -110,7 +124,7 @@ class World:
         station = None
         if landed or hovering:
             stations = list(self.tool_stations.values())
-            station = station_in_reach(vehicle.position, stations, self.rules, with_tools=True)
+            station = station_in_reach(vehicle.position, stations, self.rules)
         tool = station.take() if station is not None else None
         if station is None or tool is None:
             return "Gripper: grabbed nothing"
@@ -129,7 +143,7 @@ class World:
             log.info("%s delivered %s to %s", vehicle.id, tool.id, worker)
             return f"Gripper: delivered {tool.id} to {worker}"
         stations = list(self.tool_stations.values())
-        station = station_in_reach(pos, stations, self.rules, with_tools=False)
+        station = station_in_reach(pos, stations, self.rules)
         if station is not None:
             station.put(tool)
         sid = station.id if station is not None else None

@@ -15,6 +15,7 @@ STATUS_BY_CODE: dict[str, int] = {
     "invalid_request": 422,
     "invalid_key": 422,
     "unknown_gesture": 422,
+    "tool_out_of_stock": 422,
     "not_found": 404,
     "conflict": 409,
     "invalid_transition": 409,

@@ -34,7 +34,7 @@ def main(argv: list[str] | None = None) -> int:
     args = parser.parse_args(argv)
     bus_config = start(args, "gateway")
     try:
-        scenario = load(args.scenario)
+        scenario = load(args.scenario, site=args.site)
         vocabulary = Vocabulary.load(args.gestures)
         bus = Bus.open(bus_config)
     except (ScenarioError, Unavailable, OSError) as exc:

@@ -107,7 +107,8 @@ class InspectAction(msgspec.Struct, frozen=True, kw_only=True, tag="inspect", ta
 class MonitorAction(msgspec.Struct, frozen=True, kw_only=True, tag="monitor", tag_field="kind"):
     """Watch a worker with ``k`` UAVs starting together, for ``duration_s``.
 
-    Slot ``s`` sits at ``standoff_m`` from the worker at bearing 2*pi*s/k.
+    Slot ``s`` sits ``standoff_m`` from the worker horizontally at bearing
+    2*pi*s/k, ``height_m`` above them (never at a person's own height).
     """
 
     id: str
@@ -116,7 +117,12 @@ class MonitorAction(msgspec.Struct, frozen=True, kw_only=True, tag="monitor", ta
     worker_m: Vec3
     k: int = 1
     standoff_m: float = 5.0
+    height_m: float = 3.0
     duration_s: float
+    start_s: float | None = None
+    """A synchronised start already promised to the UAVs: kept whenever it
+    is still feasible, so that a replan does not move a start the fleet is
+    waiting for (which would wait again, and again)."""
 
 
 class DeliverAction(msgspec.Struct, frozen=True, kw_only=True, tag="deliver", tag_field="kind"):
@@ -171,3 +177,6 @@ class Problem(msgspec.Struct, frozen=True, kw_only=True):
     actions: tuple[Action, ...] = ()
     weights: CostWeights = CostWeights()
     min_monitor_segment_s: float = 20.0
+    min_altitude_m: float = 0.0
+    """Lowest z of any service position (waypoint, slot, pick, drop); the
+    validator reports a step below it as ``too_low``."""

@@ -40,10 +40,10 @@ RANDOM_T0 = 2
 
 
 def slot_position(a: MonitorAction, slot: int) -> Vec3:
-    """Stand-off position of ``slot``: bearing 2*pi*slot/k at the worker's height."""
+    """Stand-off position of ``slot``: bearing 2*pi*slot/k, ``height_m`` above the worker."""
     x, y, z = a.worker_m
     ang = 2 * pi * slot / a.k
-    return (x + a.standoff_m * cos(ang), y + a.standoff_m * sin(ang), z)
+    return (x + a.standoff_m * cos(ang), y + a.standoff_m * sin(ang), z + a.height_m)
 
 
 def _cover(ctx: Ctx, a: MonitorAction, t0: float, uids: list[str]) -> float | None:
@@ -162,6 +162,15 @@ def repair(ctx: Ctx, a: MonitorAction, gaps: list[tuple[float, int, float]]) -> 
     return False
 
 
+def _keep_start(ctx: Ctx, a: MonitorAction, uids: list[str]) -> bool:
+    """Commit a coverage from the promised ``a.start_s``; False (unchanged) if infeasible."""
+    snap = ctx.snapshot()
+    if _cover(ctx, a, a.start_s, uids) is not None:
+        return True
+    ctx.restore(snap)
+    return False
+
+
 def place_monitor(ctx: Ctx, a: MonitorAction) -> None:
     uids = ctx.capable("monitor")
     if not uids:
@@ -181,6 +190,8 @@ def place_monitor(ctx: Ctx, a: MonitorAction) -> None:
         ctx.add_unplaced(a.id, None, "unreachable_with_full_battery")
         return
     base = max(a.release_s, ctx.problem.now_s)
+    if a.start_s is not None and a.start_s >= base and _keep_start(ctx, a, uids):
+        return
     arrivals = sorted(
         max(base, r.tail().t + dist(r.tail().pos, pos0) / r.kin.speed_mps)
         for r in (ctx.routes[u] for u in uids)

@@ -10,7 +10,7 @@ each with a stable code; an empty list means the plan is valid.
 from __future__ import annotations
 
 from collections import defaultdict
-from math import dist
+from math import cos, dist, pi, sin
 
 from ground_station.planner.model import DeliverAction, InspectAction, MonitorAction, Problem
 from ground_station.planner.result import Plan, Violation
@@ -203,6 +203,8 @@ def _check_action_step(rep, problem, uid, caps, s, act, where, drop_s=None) -> N
         return
     if s.arrive_s < act.release_s - TOL_S:
         rep.add("before_release", f"{where}: starts before release", uid, act.id)
+    if s.position_m[2] < problem.min_altitude_m - TOL_M:
+        rep.add("too_low", f"{where}: z {s.position_m[2]:.1f} m below the minimum", uid, act.id)
     if isinstance(act, InspectAction):
         if s.index is None or not 0 <= s.index < len(act.waypoints):
             rep.add("bad_index", f"{where}: waypoint index {s.index}", uid, act.id)
@@ -211,8 +213,8 @@ def _check_action_step(rep, problem, uid, caps, s, act, where, drop_s=None) -> N
     elif isinstance(act, MonitorAction):
         if s.index is None or not 0 <= s.index < act.k:
             rep.add("bad_index", f"{where}: slot {s.index}", uid, act.id)
-        if abs(dist(act.worker_m, s.position_m) - act.standoff_m) > STANDOFF_TOL_M:
-            rep.add("wrong_position", f"{where}: not at stand-off", uid, act.id)
+        elif dist(_slot(act, s.index), s.position_m) > STANDOFF_TOL_M:
+            rep.add("wrong_position", f"{where}: not at slot {s.index}", uid, act.id)
     elif isinstance(act, DeliverAction):
         if s.tool != act.tool:
             rep.add("wrong_tool", f"{where}: tool {s.tool!r}", uid, act.id)
@@ -223,6 +225,14 @@ def _check_action_step(rep, problem, uid, caps, s, act, where, drop_s=None) -> N
                 rep.add("service_too_short", f"{where}: drop too short", uid, act.id)
         elif s.end_s - s.arrive_s < act.pick_s - TOL_S:
             rep.add("service_too_short", f"{where}: pick too short", uid, act.id)
+
+
+def _slot(act: MonitorAction, slot: int) -> tuple[float, float, float]:
+    """Where slot ``slot`` is, from the action's definition (not the planner's code)."""
+    x, y, z = act.worker_m
+    bearing = 2 * pi * slot / act.k
+    r = act.standoff_m
+    return (x + r * cos(bearing), y + r * sin(bearing), z + act.height_m)
 
 
 def _check_pads(rep: _Report, stations, pad_use) -> None:  # type: ignore[no-untyped-def]

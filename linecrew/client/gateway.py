@@ -27,6 +27,11 @@ class GatewayError(LinecrewError):
 
     code = "gateway_error"
 
+    def __init__(self, message: str, status: int | None = None, body: Any = None) -> None:
+        super().__init__(message)
+        self.status = status  # the HTTP status, when the gateway answered
+        self.body = body  # the decoded JSON error ({"error", "message", "field"}), if any
+
 
 def session(url: str | None, token: str | None) -> tuple[str, str]:
     """The gateway URL and token to use."""
@@ -62,7 +67,7 @@ class Gateway:
         except httpx.HTTPError as exc:
             raise GatewayError(f"cannot reach the gateway at {self.url}: {exc}") from exc
         if response.status_code >= 400:
-            raise GatewayError(_explain(response))
+            raise GatewayError(_explain(response), response.status_code, _body(response))
         return response.json()
 
     def events(self, after_seq: int | None = None) -> Iterator[dict[str, Any]]:
@@ -88,3 +93,10 @@ def _explain(response: httpx.Response) -> str:
     field = f" (field {body['field']})" if body.get("field") else ""
     known = f"; known: {', '.join(body['known'])}" if body.get("known") else ""
     return f"HTTP {response.status_code} {body.get('error')}: {body.get('message')}{field}{known}"
+
+
+def _body(response: httpx.Response) -> Any:
+    try:
+        return response.json()
+    except ValueError:
+        return None

@@ -11,10 +11,12 @@ from ground_station.planner.gantt import GLYPH
 
 
 def actions_table(records: list[dict[str, Any]]) -> Table:
-    """One row per action."""
+    """One row per action; the reason (why it failed, or its last change)
+    wraps instead of being cut."""
     table = Table(title="Actions")
-    for column in ("id", "kind", "state", "progress", "priority", "note"):
-        table.add_column(column)
+    for column in ("id", "kind", "state", "progress", "priority"):
+        table.add_column(column, no_wrap=True)
+    table.add_column("reason", overflow="fold")
     for r in records:
         table.add_row(
             r["action_id"],

@@ -1,7 +1,8 @@
 """``linecrew demo``: the paper's scenario end to end.
 
-Starts everything (as ``linecrew up``), submits the scenario's scripted
-actions at their times through the REST gateway, shows a live progress bar
+Starts everything (as ``linecrew up``), says what runs and what the scenario
+asks, submits the scripted actions at their times through the REST gateway,
+tells the ground station's events in plain words above a live progress bar
 per action, and ends with the executed timeline and a summary. Exit code 0
 only if every action completed.
 """
@@ -21,6 +22,7 @@ from rich.table import Table
 from linecrew.client.gateway import Gateway, GatewayError
 from linecrew.client.render import timeline
 from linecrew.launch.local_run import LocalRun
+from linecrew.launch.narrate import Narrator, intro, outcome_text
 from linecrew.launch.recorder import ExecutionRecorder
 from linecrew.launch.secure import SecureProfileError
 from linecrew.launch.supervisor import StartError
@@ -28,7 +30,7 @@ from linecrew.launch.up import add_run_arguments, options_from, scenario_from
 from linecrew.logs import configure_logging
 from linecrew.process import Shutdown
 from linecrew.scenarios import ScenarioError
-from proto import GetSimState, SimState
+from proto import GetSimState, GsEvent, SimState
 from proto.scenario import Scenario
 
 TERMINAL = {"completed", "failed", "cancelled"}
@@ -42,10 +44,12 @@ def run_mission(
     shutdown: Shutdown,
     console: Console,
     on_tick: Callable[[float, list[dict]], None] | None = None,
+    narrator: Narrator | None = None,
 ) -> tuple[list[dict], ExecutionRecorder]:
     """Submit the scripted actions on time and follow them until all end.
     ``on_tick(mission_s_since_start, records)`` runs every half second (tests
-    inject faults there)."""
+    inject faults there). With a ``narrator`` (its inbox fed by the event
+    subscription), its lines are printed above the progress bars."""
     gateway = Gateway(run.url, run.token)
     recorder = ExecutionRecorder()
     pending = sorted(scenario.actions, key=lambda a: a.at_s)
@@ -57,6 +61,12 @@ def run_mission(
         TextColumn("{task.fields[state]:<12}"),
         console=console,
     ) as progress:
+
+        def tell(events: list[GsEvent], plans: list[dict]) -> None:
+            if narrator is not None:
+                for line in narrator.lines(events, plans):
+                    progress.console.print(line, markup=False, highlight=False)
+
         bars = {a.id: progress.add_task(a.id, total=1.0, state="waiting") for a in pending}
         while not shutdown.is_set() and time.monotonic() - started < timeout_s:
             elapsed_mission_s = (time.monotonic() - started) * speedup
@@ -68,10 +78,13 @@ def run_mission(
                     "request_id": f"demo-{scripted.id}",
                 }
                 gateway.call("POST", "/v1/actions", json=body)
+            events = narrator.drain() if narrator else []  # before the plans: those are newer
             records = gateway.call("GET", "/v1/actions")
             now = time.time() * speedup
-            recorder.plans(gateway.call("GET", "/v1/plan"))
+            plans = gateway.call("GET", "/v1/plan")
+            recorder.plans(plans)
             recorder.fleet(gateway.call("GET", "/v1/fleet"), now)
+            tell(events, plans)
             for record in records:
                 if record["action_id"] in bars:
                     progress.update(
@@ -84,18 +97,24 @@ def run_mission(
             if not pending and records and all(r["state"] in TERMINAL for r in records):
                 break
             shutdown.wait(0.5)
+        if narrator is not None:  # the events behind the last records
+            shutdown.wait(0.3)
+            tell(narrator.drain(), gateway.call("GET", "/v1/plan"))
     recorder.finish(time.time() * speedup)
     return records, recorder
 
 
-def summary(records: list[dict], recorder: ExecutionRecorder, truth: SimState | None) -> Table:
-    """Actions and what the fleet did."""
+def summary(
+    records: list[dict], recorder: ExecutionRecorder, truth: SimState | None, handovers: int
+) -> Table:
+    """Each action's outcome and what the fleet did."""
     table = Table(title="Summary")
     table.add_column("what")
     table.add_column("result")
     for record in records:
-        table.add_row(record["action_id"], f"{record['state']} ({100 * record['progress']:.0f} %)")
+        table.add_row(record["action_id"], outcome_text(record))
     table.add_row("recharges flown", str(recorder.count("recharge")))
+    table.add_row("hand-overs seen", str(handovers))
     if truth is not None:
         delivered = ", ".join(f"{d.tool}->{d.worker_id} by {d.uav_id}" for d in truth.deliveries)
         table.add_row("tools delivered (simulator)", delivered or "none")
@@ -125,18 +144,21 @@ def main(argv: list[str] | None = None) -> int:
                 f"[bold]linecrew demo[/]: {scenario.description.strip()}\n"
                 f"gateway {run.url} · logs {run.run_dir}/ · x{args.speedup:g}"
             )
+            console.print(intro(scenario, args.speedup), markup=False, highlight=False)
             start = time.time() * args.speedup
-            records, recorder = run_mission(
-                run, scenario, args.speedup, args.timeout, shutdown, console
-            )
+            narrator = Narrator(start)
             assert run.bus is not None
+            run.bus.subscribe(run.keys.events(), GsEvent, lambda _k, e: narrator.inbox.put(e))
+            records, recorder = run_mission(
+                run, scenario, args.speedup, args.timeout, shutdown, console, narrator=narrator
+            )
             truth = run.bus.query(run.keys.sim("state"), GetSimState(), SimState, 5.0)
     except (ScenarioError, StartError, GatewayError, SecureProfileError) as exc:
         print(f"linecrew demo: {exc}", file=sys.stderr)
         return 1
     rows = [(uav, "", segs) for uav, segs in sorted(recorder.segments.items())]
     console.print(timeline(rows, start, time.time() * args.speedup, "Executed"))
-    console.print(summary(records, recorder, truth))
+    console.print(summary(records, recorder, truth, narrator.handovers))
     ok = bool(records) and all(r["state"] == "completed" for r in records)
     console.print(
         "[green]every action completed[/]" if ok else "[red]not every action completed[/]"

@@ -29,8 +29,12 @@ def builtin_names() -> list[str]:
     return sorted(path.stem for path in _HERE.glob("*.yaml"))
 
 
-def load(name_or_path: str) -> Scenario:
-    """A shipped scenario by name, or a YAML / JSON file by path."""
+def load(name_or_path: str, *, site: str | None = None) -> Scenario:
+    """A shipped scenario by name, or a YAML / JSON file by path.
+
+    The site id comes from the scenario; a ``site`` (a process's ``--site``)
+    that disagrees with it is an error naming both, so that no process of a
+    run listens on another site's keys."""
     path = _HERE / f"{name_or_path}.yaml"
     if not path.exists():
         path = pathlib.Path(name_or_path)
@@ -38,7 +42,13 @@ def load(name_or_path: str) -> Scenario:
         raise ScenarioError(
             f"no scenario {name_or_path!r}: not a file, nor one of {', '.join(builtin_names())}"
         )
-    return parse(path.read_bytes(), json=path.suffix == ".json", source=str(path))
+    scenario = parse(path.read_bytes(), json=path.suffix == ".json", source=str(path))
+    if site is not None and site != scenario.site.id:
+        raise ScenarioError(
+            f"--site {site!r} disagrees with the scenario's site id {scenario.site.id!r} "
+            f"({path}); drop --site or use the scenario's"
+        )
+    return scenario
 
 
 def with_fleet_size(scenario: Scenario, uavs: int) -> Scenario:

@@ -53,6 +53,8 @@ LANDED_STATES = {
 }
 POSITION_ONLY = 0b110111111000  # SET_POSITION_TARGET type_mask: use x, y, z only
 STREAMS_HZ = {"GLOBAL_POSITION_INT": 5.0, "BATTERY_STATUS": 1.0, "EXTENDED_SYS_STATE": 1.0}
+CRASH_TEXT = "Crash:"  # ArduCopter's crash check ("Crash: Disarming")
+GRIPPER_TEXT = "Gripper:"  # what a gripper says it did (our simulator; a load sensor's driver)
 TEXT_FRESH_S = 2.0  # a STATUSTEXT this recent explains a refused command
 
 
@@ -148,9 +150,11 @@ class MavlinkLink:
         return self._spawn(self._command("land", mav.MAV_CMD_NAV_LAND))
 
     def grab(self) -> asyncio.Task[None]:
+        self._state = dataclasses.replace(self._state, gripper_text="")
         return self._spawn(self._command("gripper grab", mav.MAV_CMD_DO_GRIPPER, 1, 1))
 
     def release(self) -> asyncio.Task[None]:
+        self._state = dataclasses.replace(self._state, gripper_text="")
         return self._spawn(self._command("gripper release", mav.MAV_CMD_DO_GRIPPER, 1, 0))
 
     def change_speed(self, speed_mps: float) -> asyncio.Task[None]:
@@ -265,7 +269,7 @@ class MavlinkLink:
                     s, position=position, geo=geo, velocity=velocity, heading_deg=heading
                 )
                 self._state = dataclasses.replace(self._state, known=True)
-            case "EXTENDED_SYS_STATE":
+            case "EXTENDED_SYS_STATE" if s.flight_state is not FlightState.CRASHED:
                 state = LANDED_STATES.get(msg.landed_state, FlightState.UNKNOWN)
                 self._state = dataclasses.replace(s, flight_state=state)
             case "BATTERY_STATUS" if msg.battery_remaining >= 0:
@@ -282,6 +286,10 @@ class MavlinkLink:
                     future.set_result(msg)
             case "STATUSTEXT":
                 self._last_text = (msg.text, self.clock())
+                if msg.text.startswith(GRIPPER_TEXT):
+                    self._state = dataclasses.replace(s, gripper_text=msg.text)
+                elif msg.text.startswith(CRASH_TEXT):
+                    self._crashed(msg.text)
                 log.info("autopilot: %s", msg.text)
 
     def _on_heartbeat(self, msg: Any) -> None:
@@ -300,7 +308,18 @@ class MavlinkLink:
         mode = COPTER_MODES.get(msg.custom_mode, str(msg.custom_mode))
         if not self._state.link_ok:
             log.info("autopilot heartbeat received")
+        s = self._state
+        in_air = s.flight_state in (FlightState.FLYING, FlightState.TAKING_OFF)
+        fell = s.armed and not armed and in_air and mode not in ("LAND", "RTL")
+        if msg.system_status == mav.MAV_STATE_EMERGENCY or fell:
+            self._crashed("emergency state" if armed else "disarmed in the air")
         self._state = dataclasses.replace(self._state, armed=armed, mode=mode, link_ok=True)
+
+    def _crashed(self, why: str) -> None:
+        """The vehicle fell or hit the ground: it reports CRASHED from now on."""
+        if self._state.flight_state is not FlightState.CRASHED:
+            log.warning("vehicle crashed: %s", why)
+            self._state = dataclasses.replace(self._state, flight_state=FlightState.CRASHED)
 
     def _request_streams(self) -> None:
         self._spawn(self._streams())

@@ -49,6 +49,7 @@ class VehicleState:
     flight_state: FlightState = FlightState.UNKNOWN
     link_ok: bool = False  # heartbeats arriving
     known: bool = False  # a position has been received
+    gripper_text: str = ""  # the autopilot's last "Gripper: ..." text since a gripper command
 
     @property
     def landed(self) -> bool:

@@ -27,7 +27,8 @@ class _GripperAction(AgentBehaviour):
     def send(self) -> None:
         raise NotImplementedError
 
-    def done(self) -> None:
+    def done(self) -> str | None:
+        """Update the beliefs once the gripper acted; why it failed, if it did."""
         raise NotImplementedError
 
     def update(self) -> Status:
@@ -50,7 +51,10 @@ class _GripperAction(AgentBehaviour):
         if ctx.clock() - self._sent_at < self.hold_s():
             self.feedback_message = f"gripper {self.verb}: holding"
             return Status.RUNNING
-        self.done()
+        problem = self.done()
+        if problem is not None:
+            self.feedback_message = problem
+            return Status.FAILURE
         self.feedback_message = f"gripper {self.verb} done"
         return Status.SUCCESS
 
@@ -74,15 +78,36 @@ class PickTool(_GripperAction):
     def send(self) -> None:
         self.command.issue("grab", self.ctx.autopilot.grab())
 
-    def done(self) -> None:
+    def done(self) -> str | None:
+        """Believe the gripper holds the task's tool, unless the gripper said
+        it grabbed nothing or another tool (then that one is held and the
+        "Drop Tool" branch takes it back)."""
         task = self.ctx.mission.head
-        if isinstance(task, PickTask | DeliverTask):
-            self.ctx.tool = task.tool
-            if isinstance(task, PickTask):
-                self.ctx.tool_station_id = task.tool_station_id
-            else:
-                station = self.ctx.surroundings.tool_station_for(task.tool)
-                self.ctx.tool_station_id = station.id if station is not None else None
+        if not isinstance(task, PickTask | DeliverTask):
+            return None
+        if isinstance(task, PickTask):
+            station_id: str | None = task.tool_station_id
+        else:
+            station = self.ctx.surroundings.tool_station_for(task.tool)
+            station_id = station.id if station is not None else None
+        held = grabbed(self.ctx.vehicle.gripper_text, task.tool)
+        if held is None:
+            return f"grabbed nothing at {station_id} (no {task.tool} left?)"
+        self.ctx.tool, self.ctx.tool_station_id = held, station_id
+        if held != task.tool:
+            return f"grabbed {held} instead of {task.tool} at {station_id}"
+        return None
+
+
+def grabbed(text: str, expected: str) -> str | None:
+    """The tool a gripper report says it holds (``expected`` when the
+    autopilot says nothing, as a plain gripper does); None if it grabbed nothing."""
+    if not text.startswith("Gripper: grabbed "):
+        return expected
+    rest = text.removeprefix("Gripper: grabbed ")
+    if rest == "nothing":
+        return None
+    return rest.split(" at ", 1)[0]
 
 
 class ReleaseTool(_GripperAction):
@@ -100,6 +125,7 @@ class ReleaseTool(_GripperAction):
     def send(self) -> None:
         self.command.issue("release", self.ctx.autopilot.release())
 
-    def done(self) -> None:
+    def done(self) -> str | None:
         self.ctx.tool = None
         self.ctx.tool_station_id = None
+        return None

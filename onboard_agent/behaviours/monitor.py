@@ -11,8 +11,11 @@ from proto.plan import MonitorTask
 
 class Monitor(AgentBehaviour):
     """Keeps the slot's stand-off position (re-targeted when the worker
-    moves) and counts the time spent there; SUCCESS after ``duration_s``.
-    The time counted survives interruptions (it lives in the mission)."""
+    moves) and counts the time spent there. A planned segment is a time
+    window: SUCCESS at its ``end_s`` (mission seconds), so the k UAVs of a
+    slot set leave together and a relieved UAV stays until its relief's
+    start; a task without times ends after ``duration_s`` on station. The
+    time counted survives interruptions (it lives in the mission)."""
 
     def __init__(self, ctx: Context, name: str = "Monitoring") -> None:
         super().__init__(name, ctx)
@@ -33,12 +36,13 @@ class Monitor(AgentBehaviour):
             return Status.FAILURE
         ctx.mission.start(task)
         now = ctx.clock()
-        if self._last_tick is not None:
+        if self._last_tick is not None and _in_window(task, ctx.wall()):
             ctx.mission.add_monitored(task.task_id, now - self._last_tick)
         self._last_tick = now
         done_s = ctx.mission.monitored_s(task.task_id)
-        if done_s >= task.duration_s:
-            self.feedback_message = f"monitored {task.worker_id} for {task.duration_s:.0f} s"
+        over = ctx.wall() >= task.end_s if task.end_s > 0 else done_s >= task.duration_s
+        if over:
+            self.feedback_message = f"monitored {task.worker_id} for {done_s:.0f} s"
             return Status.SUCCESS
         config = ctx.config
         moved = self._sent is None or self._sent.distance_to(slot) > config.follow_threshold_m
@@ -47,3 +51,10 @@ class Monitor(AgentBehaviour):
             self._sent, self._sent_at = slot, now
         self.feedback_message = f"monitoring {task.worker_id}, {done_s:.0f}/{task.duration_s:.0f} s"
         return Status.RUNNING
+
+
+def _in_window(task: MonitorTask, now_s: float) -> bool:
+    """Whether ``now_s`` lies in the task's planned window (always, for a
+    task without times): seconds on station before the window (a relief
+    that arrived early) are not this task's work."""
+    return task.end_s <= 0 or task.end_s - task.duration_s <= now_s

@@ -37,9 +37,24 @@ def test_the_papers_actions_are_valid():
             "not at tp-wrench",
         ),
         (
-            InspectAction(waypoints=[WaypointSpec(position=Point(x_m=2e6, y_m=0))]),
+            InspectAction(waypoints=[WaypointSpec(position=Point(x_m=2e6, y_m=0, z_m=5))]),
             "action.waypoints[0].position",
-            "from the site",
+            "outside the site's area",
+        ),
+        (
+            InspectAction(waypoints=[WaypointSpec(position=Point(x_m=0, y_m=7, z_m=-3))]),
+            "action.waypoints[0].position.z_m",
+            "below the minimum flight altitude 2 m",
+        ),
+        (
+            InspectAction(waypoints=[WaypointSpec(position=Point(x_m=0, y_m=7, z_m=1.5))]),
+            "action.waypoints[0].position.z_m",
+            "below the minimum flight altitude",
+        ),
+        (
+            MonitorAction(worker_id="W1", uavs=3, duration_s=100_000),
+            "action.duration_s",
+            "cannot cover 100000 s even with hand-overs",
         ),
         (
             InspectAction(waypoints=[WaypointSpec(position=Point(x_m=float("nan"), y_m=0))]),

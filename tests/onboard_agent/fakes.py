@@ -46,6 +46,7 @@ class FakeAutopilot:
         self.hold: set[str] = set()  # commands left unacknowledged
         self.grabbed = 0
         self.released = 0
+        self.gripper_says = ""  # the "Gripper: ..." text a grab answers with
 
     def update(self, **changes: object) -> None:
         self.state = dataclasses.replace(self.state, **changes)
@@ -114,6 +115,7 @@ class FakeAutopilot:
     def grab(self):
         future = self._answer("grab", self.state.position)
         self.grabbed += 1
+        self.update(gripper_text=self.gripper_says)
         return future
 
     def release(self):

@@ -76,3 +76,27 @@ def test_a_tool_nobody_needs_is_dropped_before_the_next_task():
     assert released_at.distance_to(hammer_point) <= 1.5  # back where it was picked
     assert rig.mission.waypoints_done("t1") == []  # dropping came first
     rig.run_until(lambda: rig.mission.head is None)
+
+
+def test_a_grab_that_got_nothing_fails_the_pick_instead_of_delivering_air():
+    rig = Rig(config=AgentConfig(task_attempts=1))
+    rig.autopilot.gripper_says = "Gripper: grabbed nothing"
+    rig.agent.offer_plan(plan(pick(), deliver()))
+    rig.run_until(lambda: rig.mission.head is None)
+    assert rig.autopilot.released == 0
+    results = {o.task_id: (o.result, o.reason) for o in rig.outcomes()}
+    assert results["p1"][0] is OutcomeResult.FAILED
+    assert "grabbed nothing" in results["p1"][1]
+    assert rig.agent.ctx.tool is None
+
+
+def test_the_wrong_tool_grabbed_fails_the_pick_and_is_taken_back():
+    rig = Rig(config=AgentConfig(task_attempts=1))
+    rig.autopilot.gripper_says = "Gripper: grabbed allen-wrench at tp-allen-wrench"
+    rig.agent.offer_plan(plan(pick(), deliver()))
+    rig.run_until(lambda: rig.autopilot.released == 1)
+    [first, *_] = rig.outcomes()
+    assert (first.task_id, first.result) == ("p1", OutcomeResult.FAILED)
+    assert "grabbed allen-wrench instead of wrench" in first.reason
+    released_at = dict(rig.autopilot.calls)["release"]
+    assert released_at.distance_to(RACK) <= 1.5  # dropped back at a tool station, not the worker

@@ -1,7 +1,9 @@
 from __future__ import annotations
 
+import pytest
+
 import proto
-from sim_fleet import World
+from sim_fleet import SafetyRules, World
 from sim_fleet.from_proto import scenario_from_proto
 
 
@@ -48,3 +50,38 @@ def test_proto_site_and_fleet_become_a_world():
     v = w.vehicle("uav1")
     assert v.home == (1.0, 2.0, 0.0) and v.has_gripper and v.battery.capacity_wh == 80.0
     assert w.tool_stations["T1"].tools[0].id == "hammer"
+
+
+def _site(**kw) -> proto.Site:
+    return proto.Site(
+        origin=proto.GeoPoint(lat_deg=37.4, lon_deg=-6.0),
+        stations=[proto.ChargingStation(id="C1", position=proto.Point(x_m=0.0, y_m=0.0))],
+        **kw,
+    )
+
+
+_FLEET = proto.Fleet(
+    types=[proto.UavType(name="q", capabilities={proto.Capability.INSPECT: 0.0})],
+    uavs=[proto.UavSpec(id="uav1", type="q", home_station="C1")],
+)
+
+
+def test_site_safety_distances_reach_the_simulator():
+    safety = proto.Safety(people_clearance_m=4.0, separation_m=2.5, min_altitude_m=3.0)
+    sc = scenario_from_proto(_site(safety=safety), _FLEET)
+    assert sc.safety == SafetyRules(people_clearance_m=4.0, separation_m=2.5)
+    default = scenario_from_proto(_site(), _FLEET).safety
+    assert default.people_clearance_m == proto.Safety().people_clearance_m
+    assert default.separation_m == proto.Safety().separation_m
+    with pytest.raises(ValueError, match="ground"):
+        scenario_from_proto(_site(safety=proto.Safety(ground_z_m=5.0)), _FLEET)
+
+
+def test_tool_count_gives_the_station_that_many_copies():
+    tools = [proto.Tool(name="hammer", mass_kg=1.5, count=3), proto.Tool(name="pliers")]
+    station = proto.ToolStation(id="T1", position=proto.Point(x_m=3.0, y_m=3.0), tools=tools)
+    w = World(scenario_from_proto(_site(tool_stations=[station]), _FLEET))
+    held = [t.id for t in w.tool_stations["T1"].tools]
+    assert held == ["hammer"] * 3 + ["pliers"]
+    assert held.count("hammer") == station.stock("hammer")
+    assert w.tool_stations["T1"].tools[0].mass_kg == 1.5

@@ -2,10 +2,13 @@
 
 from __future__ import annotations
 
+from sim_fleet import World
 from sim_fleet import autopilot as ap
 from sim_fleet.events import Result
 from sim_fleet.modes import FlightState
+from sim_fleet.vehicle import AutopilotParams
 from tests.sim_fleet.helpers import CARRIER, airborne, command, run_until, world
+from tests.sim_fleet.small_world import small_world
 
 GRIPPER = 211
 GRAB, RELEASE = 1, 0
@@ -77,3 +80,25 @@ def test_failed_gripper_acknowledges_but_does_nothing():
     goto(w, v, (20.0, 0.0, 4.0))
     assert command(w, v, GRIPPER, 1, GRAB).result is Result.ACCEPTED
     assert v.holding is None
+
+
+def test_grab_takes_only_from_the_nearest_station_even_when_it_is_empty():
+    # small world: P-wrench at (1, 5, 3), P-allen_wrench 1 m east, W1 at (0, 10, 3)
+    w = World(small_world(1), params=AutopilotParams(auto_disarm_s=None))
+    v = w.vehicle("uav1")
+    airborne(w, v, 4.5)
+    goto(w, v, (1.2, 5.0, 4.5))
+    command(w, v, GRIPPER, 1, GRAB)
+    assert v.holding is not None and v.holding.id == "wrench"
+    goto(w, v, (0.0, 11.0, 5.0))
+    command(w, v, GRIPPER, 1, RELEASE)
+    assert [d.tool_id for d in w.deliveries] == ["wrench"]
+    goto(w, v, (1.2, 5.0, 4.5))  # back over the emptied wrench station
+    v.take_texts()
+    command(w, v, GRIPPER, 1, GRAB)
+    assert v.holding is None
+    assert [t.text for t in v.take_texts()] == ["Gripper: grabbed nothing"]
+    assert [t.id for t in w.tool_stations["P-allen_wrench"].tools] == ["allen_wrench"]
+    goto(w, v, (1.8, 5.0, 4.5))  # nearer the allen wrench now
+    command(w, v, GRIPPER, 1, GRAB)
+    assert v.holding is not None and v.holding.id == "allen_wrench"

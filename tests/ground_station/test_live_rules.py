@@ -1,0 +1,154 @@
+"""The mission manager's rules for a running fleet: which outcomes replan,
+synchronised starts that stay put, task ids that are never reused, tool
+stock, deliveries confirmed by telemetry, crashes handled at once."""
+
+from __future__ import annotations
+
+import msgspec
+import pytest
+
+from ground_station.inventory import OutOfStock
+from proto import (
+    ActionState,
+    CancelAction,
+    DeliverAction,
+    EventKind,
+    FlightState,
+    MonitorAction,
+    MonitorTask,
+    OutcomeResult,
+    SubmitAction,
+    TaskOutcome,
+    WaitTask,
+)
+from tests.ground_station.harness import Harness
+
+ALL = ("uav-1", "uav-2", "uav-3")
+
+
+@pytest.fixture
+def gs(tmp_path):
+    harness = Harness(str(tmp_path / "gs.db"))
+    harness.bring_up(*ALL)
+    harness.sent.clear()
+    return harness
+
+
+def submit(gs: Harness, action, action_id: str):
+    return gs.manager.submit(SubmitAction(request_id=action_id, action=action, action_id=action_id))
+
+
+def outcome(gs: Harness, uav_id: str, task, result=OutcomeResult.COMPLETED, **extra) -> None:
+    plan = gs.replanner.plans[uav_id]
+    gs.manager.on_outcome(
+        TaskOutcome(
+            uav_id=uav_id,
+            task_id=task.task_id,
+            action_id=task.action_id,
+            epoch=plan.epoch,
+            result=result,
+            **extra,
+        )
+    )
+
+
+def pair_monitor(gs: Harness) -> dict[str, list]:
+    submit(gs, MonitorAction(worker_id="W2", uavs=2, standoff_m=4, duration_s=120), "watch")
+    return {u: list(gs.replanner.plans[u].tasks) for u in ALL}
+
+
+def test_a_finished_wait_replans_nothing_and_the_synchronised_start_stays(gs):
+    plans = pair_monitor(gs)
+    waiting = next((u for u, tasks in plans.items() if tasks and isinstance(tasks[0], WaitTask)))
+    starts = {
+        t.end_s - t.duration_s
+        for tasks in plans.values()
+        for t in tasks
+        if isinstance(t, MonitorTask)
+    }
+    epoch = gs.store.counter("epoch")
+    gs.now = plans[waiting][0].until_s  # the wait ends, shortly before the start
+    outcome(gs, waiting, plans[waiting][0])
+    assert gs.store.counter("epoch") == epoch, "a finished wait is not a trigger"
+    gs.manager.replan("some other trigger")
+    again = {
+        t.end_s - t.duration_s
+        for u in ALL
+        for t in gs.replanner.plans[u].tasks
+        if isinstance(t, MonitorTask)
+    }
+    assert again == starts, "the promised start did not move"
+
+
+def test_a_replan_that_changes_nothing_bumps_no_epoch_and_emits_no_event(gs):
+    pair_monitor(gs)
+    epoch, events = gs.store.counter("epoch"), len(gs.events)
+    gs.manager.replan("nothing new")
+    gs.manager.replan("still nothing")
+    assert gs.store.counter("epoch") == epoch
+    assert gs.events[events:] == []
+    assert gs.replanner.stats.unchanged >= 2
+
+
+def test_a_monitoring_segment_never_gets_the_id_of_one_already_flown(gs):
+    plans = pair_monitor(gs)
+    uav, segment = next(
+        (u, t) for u, tasks in plans.items() for t in tasks if isinstance(t, MonitorTask)
+    )
+    gs.now = segment.end_s - 60  # half of the window flown, then the segment ends early
+    outcome(gs, uav, segment, OutcomeResult.ABORTED, progress=0.5, flown_s=60.0)
+    record = gs.store.action("watch")
+    assert record.segments == {uav: 1}
+    assert record.monitored_s == pytest.approx(30.0)  # 60 s on one of two slots
+    later = [t for t in gs.replanner.plans[uav].tasks if isinstance(t, MonitorTask)]
+    assert all(t.task_id != segment.task_id for t in later)
+
+
+def test_the_last_copy_of_a_tool_is_reserved_and_given_back_on_cancel(gs):
+    wrench = DeliverAction(tool="wrench", tool_station_id="tp-wrench", worker_id="W1")
+    submit(gs, wrench, "first")
+    with pytest.raises(OutOfStock) as refused:
+        submit(gs, msgspec.structs.replace(wrench, worker_id="W2"), "second")
+    assert refused.value.code == "tool_out_of_stock" and refused.value.field == "action.tool"
+    assert gs.store.action("second") is None
+    gs.manager.cancel(CancelAction(request_id="c", action_id="first"))
+    assert submit(gs, wrench, "third").state == ActionState.PLANNED
+
+
+def test_a_drop_without_the_tool_seen_in_telemetry_is_not_a_delivery(gs):
+    submit(gs, DeliverAction(tool="wrench", tool_station_id="tp-wrench", worker_id="W1"), "d")
+    tasks = gs.replanner.plans["uav-1"].tasks
+    pick, drop = tasks[0], tasks[1]
+    outcome(gs, "uav-1", pick)
+    outcome(gs, "uav-1", drop)  # telemetry never showed the wrench held
+    assert gs.store.action("d").state != ActionState.COMPLETED
+    faults = [e.detail for e in gs.events if e.kind == EventKind.FAULT]
+    assert any("not confirmed" in d and "no tool" in d for d in faults), faults
+
+
+def test_a_drop_with_the_tool_carried_to_the_worker_completes(gs):
+    submit(gs, DeliverAction(tool="wrench", tool_station_id="tp-wrench", worker_id="W1"), "d")
+    pick, drop = gs.replanner.plans["uav-1"].tasks[:2]
+    outcome(gs, "uav-1", pick)
+    worker = gs.scenario.site.worker("W1").position
+    carrying = msgspec.structs.replace(
+        gs.telemetry("uav-1"), tool="wrench", position=worker, flight_state=FlightState.FLYING
+    )
+    gs.monitor.on_telemetry(carrying, gs.now)
+    gs.manager.on_telemetry(carrying)
+    drop = next(t for t in gs.replanner.plans["uav-1"].tasks if t.task_id == drop.task_id)
+    outcome(gs, "uav-1", drop)
+    assert gs.store.action("d").state == ActionState.COMPLETED
+
+
+def test_a_crashed_uav_is_declared_at_once_and_its_work_goes_elsewhere(gs):
+    plans = pair_monitor(gs)
+    victim = next(u for u, tasks in plans.items() if any(isinstance(t, MonitorTask) for t in tasks))
+    crashed = msgspec.structs.replace(gs.telemetry(victim), flight_state=FlightState.CRASHED)
+    gs.monitor.on_telemetry(crashed, gs.now)
+    gs.advance(0.1)  # far less than the 5 s grace
+    assert (EventKind.UAV_CRASHED, victim) in [(e.kind, e.uav_id) for e in gs.events]
+    watchers = {
+        u for u in ALL if any(isinstance(t, MonitorTask) for t in gs.replanner.plans[u].tasks)
+    }
+    assert victim not in watchers and len(watchers) == 2
