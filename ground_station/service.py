@@ -110,16 +110,16 @@ class GroundStation:
     def _on_telemetry(self, _key: str, telemetry: Telemetry) -> None:
         if self.monitor.known(telemetry.uav_id):
             self.monitor.on_telemetry(telemetry, time.monotonic())
-            self.manager.on_telemetry(telemetry)
+            self.manager.reports.on_telemetry(telemetry)
 
     def _on_status(self, _key: str, status: AgentStatus) -> None:
         self.monitor.on_status(status)
         if self.monitor.known(status.uav_id):
-            self.manager.on_status(status)
+            self.manager.reports.on_status(status)
 
     def _on_outcome(self, _key: str, outcome: TaskOutcome) -> None:
         if self.monitor.known(outcome.uav_id):
-            self.manager.on_outcome(outcome)
+            self.manager.reports.on_outcome(outcome)
 
     def _on_token(self, key: str, alive: bool) -> None:
         parsed = self.keys.parse(key)
@@ -150,7 +150,7 @@ class GroundStation:
 
     def metrics(self) -> dict[str, float]:
         """Counters and timings in one place."""
-        stats, counters = self.replanner.stats, self.manager.counters
+        stats, counters = self.replanner.stats, self.manager.reports.counters
         values: dict[str, float] = {
             "replans": stats.count,
             "replan_seconds_total": stats.total_s,

@@ -45,6 +45,7 @@ class Mission:
         self._waypoints_done: dict[str, list[int]] = {}
         self._monitored_s: dict[str, float] = {}
         self._failures: dict[str, int] = {}
+        self._tools: dict[str, str] = {}  # the tool a pick grabbed / a drop released, per task
         self._started: set[str] = set()
 
     # -- plans --------------------------------------------------------------------
@@ -115,6 +116,11 @@ class Mission:
                 return min(1.0, self.monitored_s(task.task_id) / duration)
         return 0.0
 
+    def note_tool(self, task: Task, tool: str | None) -> None:
+        """The gripper grabbed (pick) or released (drop) ``tool`` for ``task``."""
+        if tool is not None:
+            self._tools[task.task_id] = tool
+
     def note_failure(self, task: Task) -> int:
         """Count a failed attempt at ``task``; returns the attempts so far."""
         self._failures[task.task_id] = self._failures.get(task.task_id, 0) + 1
@@ -176,6 +182,7 @@ class Mission:
             waypoints_done=self.waypoints_done(task.task_id),
             stamp_s=self.wall(),
             flown_s=self.monitored_s(task.task_id),
+            tool=self._tools.get(task.task_id),
         )
         log.info("task %s %s %s", task.task_id, result, reason, extra={"uav_id": self.uav_id})
         self.outbox.append(outcome)

@@ -61,7 +61,10 @@ def _safe(ctx: Context, point: Point) -> Point:
 
 def monitor_slot(ctx: Context) -> Point | None:
     """Slot ``slot`` of ``slots`` on a circle of ``standoff_m`` around the
-    worker, ``height_m`` above them (never at a person's own height)."""
+    worker, ``height_m`` above them (never at a person's own height). Before
+    the segment's window begins (a relief that arrived early, while the UAV
+    it relieves still holds the slot) the point lies ``handover_hold_m``
+    farther out on the same bearing, clear of that UAV."""
     task = ctx.mission.head
     if not isinstance(task, MonitorTask):
         return None
@@ -69,21 +72,27 @@ def monitor_slot(ctx: Context) -> Point | None:
     if worker is None:
         return None
     angle = 2 * math.pi * task.slot / task.slots
+    early = task.end_s > 0 and ctx.wall() < task.end_s - task.duration_s
+    radius = task.standoff_m + (ctx.config.handover_hold_m if early else 0.0)
     slot = Point(
-        x_m=worker.x_m + task.standoff_m * math.cos(angle),
-        y_m=worker.y_m + task.standoff_m * math.sin(angle),
+        x_m=worker.x_m + radius * math.cos(angle),
+        y_m=worker.y_m + radius * math.sin(angle),
         z_m=worker.z_m + task.height_m,
     )
     return _safe(ctx, slot)
 
 
 def drop_point(ctx: Context) -> Point | None:
-    """Above the worker of the head delivery task."""
+    """Above the worker of the head delivery task: ``deliver_height_m``, and
+    never nearer them than the site's people clearance."""
     task = ctx.mission.head
     if not isinstance(task, DeliverTask):
         return None
     worker = ctx.surroundings.worker_position(task.worker_id)
-    return _safe(ctx, _above(worker, ctx.config.deliver_height_m)) if worker is not None else None
+    if worker is None:
+        return None
+    height = max(ctx.config.deliver_height_m, ctx.surroundings.site.safety.people_clearance_m)
+    return _safe(ctx, _above(worker, height))
 
 
 def pick_point(ctx: Context) -> Point | None:

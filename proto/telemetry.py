@@ -77,7 +77,8 @@ class TaskOutcome(Message, frozen=True, kw_only=True):
     but change nothing). ``waypoints_done`` lists inspection waypoint indices
     visited, so a split inspection resumes where it stopped. ``flown_s`` is
     the time spent on station for a monitoring task, measured on board: the
-    ground station credits that, not the planned duration.
+    ground station credits that, not the planned duration. ``tool`` is the
+    tool the gripper grabbed (pick) or released (drop), as the agent saw it.
     """
 
     uav_id: Id
@@ -90,6 +91,7 @@ class TaskOutcome(Message, frozen=True, kw_only=True):
     waypoints_done: list[int] = []
     stamp_s: float = 0.0
     flown_s: NonNegative = 0.0
+    tool: Id | None = None
 
 
 class HumanPose(Message, frozen=True, kw_only=True):

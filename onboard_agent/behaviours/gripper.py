@@ -94,6 +94,7 @@ class PickTool(_GripperAction):
         if held is None:
             return f"grabbed nothing at {station_id} (no {task.tool} left?)"
         self.ctx.tool, self.ctx.tool_station_id = held, station_id
+        self.ctx.mission.note_tool(task, held)
         if held != task.tool:
             return f"grabbed {held} instead of {task.tool} at {station_id}"
         return None
@@ -126,6 +127,9 @@ class ReleaseTool(_GripperAction):
         self.command.issue("release", self.ctx.autopilot.release())
 
     def done(self) -> str | None:
+        task = self.ctx.mission.head
+        if isinstance(task, DeliverTask):
+            self.ctx.mission.note_tool(task, self.ctx.tool)
         self.ctx.tool = None
         self.ctx.tool_station_id = None
         return None

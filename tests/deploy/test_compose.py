@@ -19,6 +19,7 @@ from rich.console import Console
 from linecrew.launch.demo import TERMINAL, run_mission
 from linecrew.process import Shutdown
 from linecrew.scenarios import load
+from proto.mission import DeliverAction
 from proto.scenario import Scenario
 from tests.deploy.compose import AGENTS, Stack, poll
 from tests.deploy.conftest import SPEEDUP
@@ -34,9 +35,18 @@ SHORT_CUT_S = 1.5
 LONG_CUT_S = 9.0  # well beyond both
 
 
-def renamed(scenario: Scenario, prefix: str) -> Scenario:
-    """The scenario with fresh action ids, to fly it again on the same stack."""
-    actions = [msgspec.structs.replace(a, id=f"{prefix}-{a.id}") for a in scenario.actions]
+def renamed(scenario: Scenario, prefix: str, tool: str) -> Scenario:
+    """The scenario with fresh action ids, to fly it again on the same stack;
+    deliveries bring ``tool`` (from its own station): the first flight used
+    the site's only wrench, and a delivered tool stays with the worker."""
+    actions = []
+    for scripted in scenario.actions:
+        action = scripted.action
+        if isinstance(action, DeliverAction):
+            action = msgspec.structs.replace(action, tool=tool, tool_station_id=f"tp-{tool}")
+        actions.append(
+            msgspec.structs.replace(scripted, id=f"{prefix}-{scripted.id}", action=action)
+        )
     return msgspec.structs.replace(scenario, actions=actions)
 
 
@@ -99,7 +109,7 @@ def test_the_papers_scenario_completes_in_containers(fleet):
 
 
 def test_killing_the_ground_station_mid_mission_loses_no_action(fleet):
-    scenario = renamed(PAPER, "gs-kill")
+    scenario = renamed(PAPER, "gs-kill", "hammer")
     ids = {a.id for a in scenario.actions}
     killed: dict[str, object] = {}
 

@@ -28,7 +28,7 @@ def test_linecrew_demo_runs_a_site_that_is_not_default(tmp_path):
         [
             sys.executable,
             "-m",
-            "linecrew",
+            "linecrew.cli",
             "demo",
             "--scenario",
             scenario,

@@ -10,12 +10,12 @@ from __future__ import annotations
 import dataclasses
 import itertools
 import math
-import time
 from collections.abc import Callable
 
 from linecrew.client.gateway import Gateway
 from linecrew.launch.local_run import LocalRun
 from proto import GetHistory, GetSimState, GsEvent, HistoryReply, Point, SimState
+from tests.support.processes import wait_until
 
 TERMINAL = {"completed", "failed", "cancelled"}
 SLOT_TOLERANCE_M = 1.5
@@ -45,16 +45,16 @@ class TruthLog:
         return state
 
     def until(self, what: str, predicate: Callable[[], object], timeout_s: float) -> object:
-        """Sample every 0.2 s until ``predicate()`` is truthy."""
-        deadline = time.monotonic() + timeout_s
-        while True:
+        """Sample every 0.2 s until ``predicate()`` is truthy; its value."""
+        seen: list[object] = [None]
+
+        def sampled() -> object:
             self.sample()
-            value = predicate()
-            if value:
-                return value
-            if time.monotonic() > deadline:
-                raise AssertionError(f"timed out after {timeout_s:.0f} s: {what}")
-            time.sleep(0.2)
+            seen[0] = predicate()
+            return seen[0]
+
+        wait_until(sampled, timeout_s, what, period_s=0.2)
+        return seen[0]
 
     # -- the operator's side, only to drive the test ---------------------------------
 

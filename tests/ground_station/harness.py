@@ -18,6 +18,9 @@ from proto import (
     Telemetry,
 )
 
+ALL = ("uav-1", "uav-2", "uav-3")
+"""The paper fleet."""
+
 
 class Harness:
     """Builds the ground station's components around one SQLite file."""

@@ -21,17 +21,7 @@ from proto import (
     TaskOutcome,
     WaitTask,
 )
-from tests.ground_station.harness import Harness
-
-ALL = ("uav-1", "uav-2", "uav-3")
-
-
-@pytest.fixture
-def gs(tmp_path):
-    harness = Harness(str(tmp_path / "gs.db"))
-    harness.bring_up(*ALL)
-    harness.sent.clear()
-    return harness
+from tests.ground_station.harness import ALL, Harness
 
 
 def submit(gs: Harness, action, action_id: str):
@@ -40,7 +30,7 @@ def submit(gs: Harness, action, action_id: str):
 
 def outcome(gs: Harness, uav_id: str, task, result=OutcomeResult.COMPLETED, **extra) -> None:
     plan = gs.replanner.plans[uav_id]
-    gs.manager.on_outcome(
+    gs.manager.reports.on_outcome(
         TaskOutcome(
             uav_id=uav_id,
             task_id=task.task_id,
@@ -135,7 +125,7 @@ def test_a_drop_with_the_tool_carried_to_the_worker_completes(gs):
         gs.telemetry("uav-1"), tool="wrench", position=worker, flight_state=FlightState.FLYING
     )
     gs.monitor.on_telemetry(carrying, gs.now)
-    gs.manager.on_telemetry(carrying)
+    gs.manager.reports.on_telemetry(carrying)
     drop = next(t for t in gs.replanner.plans["uav-1"].tasks if t.task_id == drop.task_id)
     outcome(gs, "uav-1", drop)
     assert gs.store.action("d").state == ActionState.COMPLETED
@@ -152,3 +142,54 @@ def test_a_crashed_uav_is_declared_at_once_and_its_work_goes_elsewhere(gs):
         u for u in ALL if any(isinstance(t, MonitorTask) for t in gs.replanner.plans[u].tasks)
     }
     assert victim not in watchers and len(watchers) == 2
+
+
+def test_a_failed_task_given_back_unchanged_is_sent_again_with_a_new_epoch(gs):
+    submit(gs, DeliverAction(tool="wrench", tool_station_id="tp-wrench", worker_id="W1"), "d")
+    pick = gs.replanner.plans["uav-1"].tasks[0]
+    epoch = gs.replanner.plans["uav-1"].epoch
+    gs.sent.clear()
+    outcome(gs, "uav-1", pick, OutcomeResult.FAILED, reason="arming refused: GPS 1: Bad fix")
+    resent = [p for p in gs.sent if p.uav_id == "uav-1"]
+    assert resent and resent[-1].epoch > epoch
+    assert resent[-1].tasks[0].task_id == pick.task_id  # the same work, which the agent dropped
+
+
+def test_a_task_that_keeps_failing_fails_its_action_with_the_agents_reason(gs):
+    submit(gs, DeliverAction(tool="wrench", tool_station_id="tp-wrench", worker_id="W1"), "d")
+    for _ in range(3):
+        pick = gs.replanner.plans["uav-1"].tasks[0]
+        outcome(gs, "uav-1", pick, OutcomeResult.FAILED, reason="grabbed nothing at tp-wrench")
+    record = gs.store.action("d")
+    assert record.state == ActionState.FAILED
+    assert "grabbed nothing" in record.reason
+    failed = [e for e in gs.events if e.kind == EventKind.ACTION_FAILED]
+    assert failed and "grabbed nothing" in failed[-1].detail
+    assert not gs.replanner.plans["uav-1"].tasks or all(
+        t.action_id != "d" for t in gs.replanner.plans["uav-1"].tasks
+    )
+
+
+def test_outcomes_heard_before_the_uav_is_back_wait_for_it(tmp_path):
+    """A restarted ground station hears re-delivered outcomes before it has
+    seen the UAV's token and telemetry: they apply once the UAV is back."""
+    first = Harness(str(tmp_path / "gs.db"))
+    first.bring_up(*ALL)
+    submit(first, DeliverAction(tool="wrench", tool_station_id="tp-wrench", worker_id="W1"), "d")
+    pick = first.replanner.plans["uav-1"].tasks[0]
+    epoch = first.replanner.plans["uav-1"].epoch
+    restarted = Harness(str(tmp_path / "gs.db"), now=first.now + 5)
+    restarted.manager.reports.on_outcome(
+        TaskOutcome(
+            uav_id="uav-1",
+            task_id=pick.task_id,
+            action_id="d",
+            epoch=epoch,
+            tool="wrench",
+            result=OutcomeResult.COMPLETED,
+        )
+    )
+    assert restarted.store.action("d").state == ActionState.PLANNED  # held, not lost nor stale
+    restarted.bring_up(*ALL)
+    assert restarted.store.action("d").state == ActionState.IN_PROGRESS
+    assert not [e for e in restarted.events if "stale" in e.detail]

@@ -5,7 +5,8 @@ from __future__ import annotations
 import msgspec
 import pytest
 
-from ground_station.missions import Conflict, NotFound
+from ground_station.action_book import NotFound
+from ground_station.missions import Conflict
 from ground_station.validation import InvalidAction
 from proto import (
     ActionState,
@@ -21,18 +22,7 @@ from proto import (
     SubmitAction,
     TaskOutcome,
 )
-from tests.ground_station.harness import Harness
-
-ALL = ("uav-1", "uav-2", "uav-3")
-
-
-@pytest.fixture
-def gs(tmp_path):
-    harness = Harness(str(tmp_path / "gs.db"))
-    harness.bring_up(*ALL)
-    assert sorted(p.uav_id for p in harness.sent) == list(ALL)  # each gets a fresh plan
-    harness.sent.clear()
-    return harness
+from tests.ground_station.harness import ALL, Harness
 
 
 def test_a_new_action_is_stored_planned_and_sent_to_the_capable_uav(gs):
@@ -108,7 +98,7 @@ def test_outcomes_complete_an_inspection_waypoint_by_waypoint(gs):
     gs.submit("inspect-loop")
     plan, task = _inspect_task(gs, "inspect-loop")
     first_half = [w.index for w in task.waypoints[:4]]
-    gs.manager.on_outcome(
+    gs.manager.reports.on_outcome(
         TaskOutcome(
             uav_id=plan.uav_id,
             task_id=task.task_id,
@@ -122,7 +112,7 @@ def test_outcomes_complete_an_inspection_waypoint_by_waypoint(gs):
     assert record.state == ActionState.IN_PROGRESS and record.waypoints_done == first_half
     plan, task = _inspect_task(gs, "inspect-loop")
     assert {w.index for w in task.waypoints}.isdisjoint(first_half)  # resumes, no repeats
-    gs.manager.on_outcome(
+    gs.manager.reports.on_outcome(
         TaskOutcome(
             uav_id=plan.uav_id,
             task_id=task.task_id,
@@ -139,7 +129,7 @@ def test_stale_outcomes_are_recorded_but_change_nothing(gs):
     gs.submit("inspect-loop")
     plan, task = _inspect_task(gs, "inspect-loop")
     other = next(u for u in ALL if u != plan.uav_id)
-    gs.manager.on_outcome(
+    gs.manager.reports.on_outcome(
         TaskOutcome(
             uav_id=other,
             task_id=task.task_id,
@@ -149,7 +139,7 @@ def test_stale_outcomes_are_recorded_but_change_nothing(gs):
         )
     )
     assert gs.store.action("inspect-loop").state == ActionState.PLANNED
-    assert gs.manager.counters.stale_outcomes == 1
+    assert gs.manager.reports.counters.stale_outcomes == 1
     assert gs.events[-1].kind == EventKind.FAULT
 
 
@@ -194,12 +184,12 @@ def test_battery_below_the_plan_replans_once_per_epoch(gs):
     gs.submit("inspect-loop")
     plan, _ = _inspect_task(gs, "inspect-loop")
     landed = gs.telemetry(plan.uav_id, battery_wh=1.0)
-    gs.manager.on_telemetry(landed)  # on a pad it draws nothing: not a battery fault
-    assert gs.manager.counters.battery_replans == 0
+    gs.manager.reports.on_telemetry(landed)  # on a pad it draws nothing: not a battery fault
+    assert gs.manager.reports.counters.battery_replans == 0
     low = msgspec.structs.replace(landed, flight_state=FlightState.FLYING)
-    gs.manager.on_telemetry(low)
-    gs.manager.on_telemetry(low)
-    assert gs.manager.counters.battery_replans == 1
+    gs.manager.reports.on_telemetry(low)
+    gs.manager.reports.on_telemetry(low)
+    assert gs.manager.reports.counters.battery_replans == 1
 
 
 def test_a_status_ahead_of_telemetry_does_not_break_replanning(gs):

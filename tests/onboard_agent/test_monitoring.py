@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import math
 
+import msgspec
 import pytest
 
 from proto.geo import GeoPoint
@@ -73,3 +74,24 @@ def test_stale_poses_are_ignored():
     rig.agent.human_pose(new)
     rig.agent.human_pose(old)
     assert rig.agent.ctx.surroundings.worker_position("W2") == point(1, 1, 3)
+
+
+def test_a_timed_segment_holds_clear_of_the_slot_until_its_window_then_leaves_at_its_end():
+    rig = Rig()
+    start = rig.wall() + 5.0  # the UAV it relieves holds the slot until then
+    task = msgspec.structs.replace(
+        monitor(slot=0, slots=1, duration_s=4.0), start_s=rig.wall(), end_s=start + 4.0
+    )
+    rig.agent.offer_plan(plan(task))
+    rig.run_until(lambda: rig.leaf() == "Monitoring")
+    held = last_goto(rig)
+    assert held.x_m == pytest.approx(W2.x_m + 4.0 + rig.agent.ctx.config.handover_hold_m)
+    assert held.z_m == pytest.approx(W2.z_m + task.height_m)  # above the worker, not beside
+    rig.run_until(lambda: rig.wall() >= start + 0.5)
+    assert last_goto(rig).x_m == pytest.approx(W2.x_m + 4.0)  # closes in once it is its turn
+    assert rig.mission.head is not None
+    rig.run_until(lambda: rig.mission.head is None)
+    assert rig.wall() >= start + 4.0 - 0.2  # left at the window's end, not before
+    [outcome] = rig.outcomes()
+    assert outcome.result is OutcomeResult.COMPLETED
+    assert outcome.flown_s == pytest.approx(4.0 - 0.5, abs=1.0)  # only seconds in the window

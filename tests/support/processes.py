@@ -25,13 +25,19 @@ __all__ = [
 ]
 
 
-def wait_until(predicate: Callable[[], object], timeout_s: float = 10.0, what: str = "") -> None:
-    """Poll ``predicate`` until it is truthy; fail the test after ``timeout_s``."""
+def wait_until(
+    predicate: Callable[[], object],
+    timeout_s: float = 10.0,
+    what: str = "",
+    period_s: float = 0.01,
+) -> None:
+    """Poll ``predicate`` every ``period_s`` until it is truthy; fail the test
+    after ``timeout_s``."""
     deadline = time.monotonic() + timeout_s
     while not predicate():
         if time.monotonic() > deadline:
             raise AssertionError(f"timed out after {timeout_s} s waiting for {what or predicate}")
-        time.sleep(0.01)
+        time.sleep(period_s)
 
 
 class Process:

@@ -1,0 +1,74 @@
+"""The action records as the ground station keeps them: read (404 if
+unknown), change state through the lifecycle (with the events it implies),
+save with the clock's stamp. Shared by requests and agents' reports."""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+
+import msgspec
+
+from ground_station.event_log import EventLog
+from ground_station.lifecycle import TERMINAL, ActionEvent, next_state
+from ground_station.store import Store
+from proto.errors import RequestError
+from proto.events import EventKind
+from proto.mission import ActionRecord, ActionState
+
+
+class NotFound(RequestError):
+    """An action id the ground station does not know. Do not retry."""
+
+    code = "not_found"
+
+
+class ActionBook:
+    """Reads and writes action records in the store."""
+
+    def __init__(self, store: Store, events: EventLog, clock: Callable[[], float]) -> None:
+        self.store = store
+        self.events = events
+        self.clock = clock
+
+    def record(self, action_id: str) -> ActionRecord:
+        """The record of ``action_id``; :class:`NotFound` if there is none."""
+        record = self.store.action(action_id)
+        if record is None:
+            raise NotFound(f"no action {action_id!r}", field="action_id")
+        return record
+
+    def live_record(self, action_id: str) -> ActionRecord:
+        """The record of an action that has not ended (else invalid_transition)."""
+        record = self.record(action_id)
+        if record.state in TERMINAL:
+            raise RequestError(
+                f"action {action_id} is {record.state}",
+                code="invalid_transition",
+                field="action_id",
+            )
+        return record
+
+    def transition(self, record: ActionRecord, event: ActionEvent, reason: str) -> None:
+        """Apply a lifecycle event; a change of state is saved and announced."""
+        state = next_state(record.state, event)
+        if state != record.state:
+            self.save(
+                msgspec.structs.replace(record, state=state, reason=reason), record.state, reason
+            )
+            self.events.emit(
+                EventKind.ACTION_STATE,
+                action_id=record.action_id,
+                detail=f"{record.state}->{state}: {reason}",
+            )
+            if state == ActionState.FAILED:
+                self.events.emit(EventKind.ACTION_FAILED, action_id=record.action_id, detail=reason)
+
+    def save(self, record: ActionRecord, previous: ActionState, reason: str) -> None:
+        """Store ``record`` (stamped now) over its ``previous`` state."""
+        now = self.clock()
+        record = msgspec.structs.replace(record, updated_s=now)
+        self.store.update_action(record, previous, now)
+
+    def in_force(self, record: ActionRecord | None) -> bool:
+        """Whether ``record`` exists and has not ended."""
+        return record is not None and record.state not in TERMINAL
