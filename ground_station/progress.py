@@ -18,7 +18,18 @@ from proto.mission import ActionRecord, InspectAction, MonitorAction
 from proto.plan import DeliverTask, InspectTask, MonitorTask, PickTask, Task
 from proto.telemetry import OutcomeResult, TaskOutcome
 
-_EPS_S = 1e-3
+TAIL_S = 5.0
+TAIL_FRACTION = 0.02
+"""A monitoring action is finished once what is left is at most the larger
+of these (5 s, 2 % of its duration): the seconds a UAV arriving a little
+late loses. Relaunching k UAVs, after recharges, for such a tail would end
+the action minutes later for no real coverage; the record keeps the true
+``monitored_s`` and its progress (below 100 %) shows the shortfall."""
+
+
+def waived_tail_s(duration_s: float) -> float:
+    """The shortfall a monitoring action of ``duration_s`` may end with."""
+    return max(TAIL_S, TAIL_FRACTION * duration_s)
 
 
 def apply_outcome(
@@ -49,7 +60,7 @@ def apply_outcome(
             record = msgspec.structs.replace(
                 record, monitored_s=monitored, progress=monitored / total, segments=segments
             )
-            if monitored >= total - _EPS_S:
+            if monitored >= total - waived_tail_s(total):
                 return record, ActionEvent.FINISHED
             return record, ActionEvent.STARTED if covered > 0 else None
         case (PickTask(), _) if completed:

@@ -49,3 +49,14 @@ def test_bench_bus_prints_real_numbers():
     assert 0 < killed["mean_ms"] < killed["lease_ms"]
     frozen = results["liveliness after SIGSTOP"]
     assert frozen["mean_ms"] > 0.5 * frozen["lease_ms"]
+
+
+def test_submit_inspect_takes_points_with_a_negative_first_coordinate(capsys, monkeypatch):
+    from linecrew.client.commands import submit_main
+
+    monkeypatch.setenv("LINECREW_URL", "http://127.0.0.1:9")  # nothing listens there
+    # no gateway runs here: parsing must get past the points and fail on the connection
+    code = submit_main(["inspect", "-5,15,3", "0,7,3,5"])
+    err = capsys.readouterr().err
+    assert "unrecognized arguments" not in err and "expected one argument" not in err
+    assert code != 0

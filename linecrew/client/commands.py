@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import re
 import sys
 import time
 from collections.abc import Callable
@@ -41,12 +42,31 @@ def _run(args: argparse.Namespace, work: Callable[[Gateway], Any], show: Callabl
     return 0
 
 
+POINT = re.compile(r"-?[\d.]+(,-?[\d.]+){2,3}")
+"""X,Y,Z[,SERVICE_S] on the command line."""
+
+
 def _point(text: str) -> dict[str, float]:
     try:
         x, y, z, *rest = (float(v) for v in text.split(","))
     except ValueError:
         raise argparse.ArgumentTypeError(f"{text!r}: expected X,Y,Z[,SERVICE_S]") from None
     return {"position": {"x_m": x, "y_m": y, "z_m": z}, "service_s": rest[0] if rest else 0.0}
+
+
+def _negative_points(argv: list[str]) -> list[str]:
+    """``inspect -5,15,3`` reads the point as an option; put ``--`` after
+    ``inspect`` so that points with a negative first coordinate are points
+    (only when no option follows, which ``--`` would swallow)."""
+    if "inspect" not in argv or "--" in argv:
+        return argv
+    at = argv.index("inspect") + 1
+    rest = argv[at:]
+    if any(POINT.fullmatch(a) and a.startswith("-") for a in rest) and not any(
+        a.startswith("-") and not POINT.fullmatch(a) for a in rest
+    ):
+        return [*argv[:at], "--", *rest]
+    return argv
 
 
 def submit_main(argv: list[str]) -> int:
@@ -66,7 +86,7 @@ def submit_main(argv: list[str]) -> int:
     deliver.add_argument("tool")
     deliver.add_argument("--from", dest="station", required=True, help="tool station id")
     deliver.add_argument("--to", dest="worker", required=True, help="worker id")
-    args = parser.parse_args(argv)
+    args = parser.parse_args(_negative_points(argv))
     body: dict[str, Any] = {"type": args.kind, "priority": args.priority}
     match args.kind:
         case "inspect":

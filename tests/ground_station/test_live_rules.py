@@ -193,3 +193,28 @@ def test_outcomes_heard_before_the_uav_is_back_wait_for_it(tmp_path):
     restarted.bring_up(*ALL)
     assert restarted.store.action("d").state == ActionState.IN_PROGRESS
     assert not [e for e in restarted.events if "stale" in e.detail]
+
+
+def test_a_monitor_short_of_its_duration_by_a_few_seconds_ends_and_says_so(gs):
+    submit(gs, MonitorAction(worker_id="W2", uavs=1, standoff_m=4, duration_s=120), "watch")
+    uav, segment = next(
+        (u, t) for u in ALL for t in gs.replanner.plans[u].tasks if isinstance(t, MonitorTask)
+    )
+    gs.now = segment.end_s
+    outcome(gs, uav, segment, flown_s=segment.duration_s - 4.0)  # arrived 4 s late
+    record = gs.store.action("watch")
+    assert record.state == ActionState.COMPLETED
+    assert record.monitored_s == pytest.approx(116.0, abs=0.5)
+    assert record.progress == pytest.approx(116.0 / 120.0, abs=0.01)  # the shortfall shows
+
+
+def test_a_monitor_short_by_more_than_the_tail_is_flown_on(gs):
+    submit(gs, MonitorAction(worker_id="W2", uavs=1, standoff_m=4, duration_s=120), "watch")
+    uav, segment = next(
+        (u, t) for u in ALL for t in gs.replanner.plans[u].tasks if isinstance(t, MonitorTask)
+    )
+    gs.now = segment.end_s
+    outcome(gs, uav, segment, flown_s=segment.duration_s - 30.0)
+    assert gs.store.action("watch").state == ActionState.IN_PROGRESS
+    more = [t for u in ALL for t in gs.replanner.plans[u].tasks if isinstance(t, MonitorTask)]
+    assert more and more[0].duration_s == pytest.approx(30.0, abs=1.0)
