@@ -41,6 +41,8 @@ finished"). A finished wait, recharge or flight home changes nothing the
 plan did not already expect, so it replans nothing, unless an action is
 waiting for a UAV (then a UAV back on its pad or recharged may take it)."""
 
+IDLE_MISMATCH_S = 5.0
+"""Mission seconds an agent may report idle while its plan has tasks."""
 MAX_TASK_FAILURES = 3
 """Failed attempts at one task (each resent after the first) before its action fails."""
 EMERGENCY_PREFIX = "emergency:"
@@ -90,6 +92,7 @@ class AgentReports:
         self._carried: dict[str, str] = {}  # the last tool each UAV's telemetry showed
         self._failures: dict[str, int] = {}  # failed outcomes per task id
         self._held: dict[str, list[TaskOutcome]] = {}  # from UAVs not back yet
+        self._idle_since: dict[str, float] = {}  # agent idle while its plan has tasks
 
     def on_outcome(self, outcome: TaskOutcome) -> None:
         """Apply an agent's outcome; stale ones are recorded only. An outcome
@@ -230,7 +233,9 @@ class AgentReports:
 
     def on_status(self, status: AgentStatus) -> None:
         """Show a monitoring action's progress while it is flown (outcomes
-        only come at the end of a segment): in progress, and its share in %."""
+        only come at the end of a segment): in progress, and its share in %;
+        and notice an agent idle on the epoch of a plan that still has work."""
+        self._check_idle(status)
         task = self._monitoring(status)
         if task is None or task.action_id is None:
             return
@@ -249,6 +254,21 @@ class AgentReports:
             record = self.book.record(record.action_id)
         if live - record.progress >= LIVE_PROGRESS_STEP:
             self.book.save(msgspec.structs.replace(record, progress=live), record.state, "flying")
+
+    def _check_idle(self, status: AgentStatus) -> None:
+        """An agent idle with an empty queue on the epoch of a plan that still
+        holds tasks (an outcome lost in an outage, a plan it never got) for
+        ``IDLE_MISMATCH_S``: send it its work again, with a new epoch."""
+        plan = self.replanner.plans.get(status.uav_id)
+        idle = status.state == AgentState.IDLE and status.queue_length == 0
+        if plan is None or not plan.tasks or not idle or status.epoch != plan.epoch:
+            self._idle_since.pop(status.uav_id, None)
+            return
+        since = self._idle_since.setdefault(status.uav_id, status.stamp_s)
+        if status.stamp_s - since >= IDLE_MISMATCH_S:
+            self._idle_since.pop(status.uav_id, None)
+            self.replanner.resend(status.uav_id)
+            self.replan(f"{status.uav_id} idle without its plan's tasks")
 
     def _monitoring(self, status: AgentStatus) -> MonitorTask | None:
         """The monitoring task ``status`` says is being flown, if any."""

@@ -67,6 +67,10 @@ FLEET_TEXT = {
 }
 
 
+RETRY_UNPLACED_S = 30.0
+"""Mission seconds between retries of actions that no UAV could take yet."""
+
+
 class Conflict(RequestError):
     """A request id reused for a different request. Use a new request id."""
 
@@ -94,6 +98,7 @@ class MissionManager:
         self.replanner = replanner
         self.clock = clock
         self.book = ActionBook(store, events, clock)
+        self._retried_s = clock()
         self.reports = AgentReports(
             scenario=scenario,
             book=self.book,
@@ -216,6 +221,17 @@ class MissionManager:
                 self.book.save(
                     msgspec.structs.replace(record, segments=segments), record.state, "UAV lost"
                 )
+
+    def retry_unplaced(self) -> None:
+        """Replan every ``RETRY_UNPLACED_S`` mission seconds while an action
+        waits for a UAV: batteries filling on pads are no event, yet they
+        make the action placeable (a replan that places nothing changes nothing)."""
+        now = self.clock()
+        if now - self._retried_s < RETRY_UNPLACED_S:
+            return
+        self._retried_s = now
+        if self.store.actions([ActionState.ACCEPTED]):
+            self.replan("retry of actions waiting for a UAV")
 
     # -- planning --------------------------------------------------------------
 

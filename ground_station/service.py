@@ -130,6 +130,7 @@ class GroundStation:
         while True:
             try:
                 self.manager.on_fleet_changes(self.monitor.check(time.monotonic()))
+                self.manager.retry_unplaced()
             except Exception:
                 log.exception("watchdog step failed")
             await asyncio.sleep(self.config.watchdog_period_s)

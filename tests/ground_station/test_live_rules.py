@@ -10,6 +10,8 @@ import pytest
 from ground_station.inventory import OutOfStock
 from proto import (
     ActionState,
+    AgentState,
+    AgentStatus,
     CancelAction,
     DeliverAction,
     EventKind,
@@ -218,3 +220,30 @@ def test_a_monitor_short_by_more_than_the_tail_is_flown_on(gs):
     assert gs.store.action("watch").state == ActionState.IN_PROGRESS
     more = [t for u in ALL for t in gs.replanner.plans[u].tasks if isinstance(t, MonitorTask)]
     assert more and more[0].duration_s == pytest.approx(30.0, abs=1.0)
+
+
+def test_an_action_no_uav_can_take_yet_is_retried_as_time_passes(gs):
+    gs.advance(10)  # no telemetry for 10 s: every UAV is lost, nobody can take work
+    submit(gs, MonitorAction(worker_id="W2", uavs=1, standoff_m=4, duration_s=60), "later")
+    assert gs.store.action("later").state == ActionState.ACCEPTED
+    replans = gs.replanner.stats.count
+    gs.manager.retry_unplaced()  # too soon after the last retry: nothing
+    assert gs.replanner.stats.count == replans
+    gs.now += 31
+    gs.manager.retry_unplaced()
+    assert gs.replanner.stats.count == replans + 1
+
+
+def test_an_agent_idle_on_a_plan_that_still_has_work_gets_it_again(gs):
+    submit(gs, DeliverAction(tool="wrench", tool_station_id="tp-wrench", worker_id="W1"), "d")
+    plan = gs.replanner.plans["uav-1"]
+    gs.sent.clear()
+    for dt in (0.0, 2.0, 4.0, 6.0):  # its queue is empty, the plan says pick + drop
+        gs.manager.reports.on_status(
+            AgentStatus(
+                uav_id="uav-1", stamp_s=gs.now + dt, state=AgentState.IDLE, epoch=plan.epoch
+            )
+        )
+    resent = [p for p in gs.sent if p.uav_id == "uav-1"]
+    assert len(resent) == 1 and resent[0].epoch > plan.epoch
+    assert [t.task_id for t in resent[0].tasks][:2] == [t.task_id for t in plan.tasks][:2]
