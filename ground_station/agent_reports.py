@@ -104,7 +104,13 @@ class AgentReports:
         self.counters.outcomes += 1
         plan = self.replanner.plans.get(outcome.uav_id)
         task = next((t for t in plan.tasks if t.task_id == outcome.task_id), None) if plan else None
-        if task is None or (plan is not None and outcome.epoch > plan.epoch):
+        since = self.replanner.assigned_since(outcome.uav_id, outcome.task_id)
+        if (
+            task is None
+            or plan is None
+            or since is None
+            or not since <= outcome.epoch <= plan.epoch
+        ):
             self.counters.stale_outcomes += 1
             self.events.emit(
                 EventKind.FAULT,

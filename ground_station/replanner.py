@@ -78,10 +78,30 @@ class Replanner:
         self.plans: dict[str, Plan] = store.latest_plans()
         self.stats = ReplanStats()
         self._resend: set[str] = set()
+        # uav -> task id -> the epoch since which its plan holds that task
+        # (restored conservatively as the stored plan's own epoch)
+        self._since: dict[str, dict[str, int]] = {
+            uav: {t.task_id: plan.epoch for t in plan.tasks} for uav, plan in self.plans.items()
+        }
 
     def resend(self, uav_id: str) -> None:
         """Give ``uav_id`` a fresh plan (higher epoch) at the next replan."""
         self._resend.add(uav_id)
+
+    def assigned_since(self, uav_id: str, task_id: str) -> int | None:
+        """The epoch since which ``uav_id``'s plan holds ``task_id`` without a
+        break (None if it does not hold it). Ids such as ``uav-1.home`` come
+        back in later plans: an outcome reported under an older epoch is about
+        an earlier task of that name."""
+        return self._since.get(uav_id, {}).get(task_id)
+
+    def _hold(self, plan: Plan) -> None:
+        """``plan`` replaces the UAV's plan; tasks carried over keep their epoch."""
+        before = self._since.get(plan.uav_id, {})
+        self._since[plan.uav_id] = {
+            t.task_id: before.get(t.task_id, plan.epoch) for t in plan.tasks
+        }
+        self.plans[plan.uav_id] = plan
 
     def finished(self, uav_id: str, task_id: str) -> None:
         """``task_id`` ended on ``uav_id``: drop it (and what preceded it) from
@@ -94,6 +114,8 @@ class Replanner:
         if task_id in ids:
             rest = plan.tasks[ids.index(task_id) + 1 :]
             self.plans[uav_id] = msgspec.structs.replace(plan, tasks=rest)
+            since = self._since.get(uav_id, {})
+            self._since[uav_id] = {t.task_id: since[t.task_id] for t in rest if t.task_id in since}
 
     def replan(self, records: list[ActionRecord], now_s: float, reason: str) -> ReplanOutcome:
         """Plan ``records`` (the actions in force) from the fleet's state now."""
@@ -131,7 +153,7 @@ class Replanner:
             ]
             self.store.save_plans(changed)
             for plan in changed:
-                self.plans[plan.uav_id] = plan
+                self._hold(plan)
                 if self.monitor.available(plan.uav_id) or plan.uav_id in self._resend:
                     self.send(plan)
                     self.stats.plans_sent += 1

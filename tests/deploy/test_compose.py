@@ -129,12 +129,6 @@ def test_killing_the_ground_station_mid_mission_loses_no_action(fleet):
     assert killed, "the ground station was never killed"
 
 
-@pytest.mark.xfail(
-    strict=False,
-    reason="known defect, open in issue 22: on a freshly built image the 150 s monitor's "
-    "segment ends after the 1.5 s cut but the action is not completed (3 of 4 clean-clone CI "
-    "runs; the no-lost / no-new-epoch part holds). Remove this mark once fixed.",
-)
 def test_a_cut_shorter_than_the_link_timeout_changes_nothing(fleet):
     uav = monitoring(fleet, "cut-short", duration_s=150)
     mark, epoch_before = fleet.last_seq(), epoch(fleet, uav)

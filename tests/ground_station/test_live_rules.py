@@ -16,6 +16,7 @@ from proto import (
     DeliverAction,
     EventKind,
     FlightState,
+    GoHomeTask,
     MonitorAction,
     MonitorTask,
     OutcomeResult,
@@ -247,3 +248,53 @@ def test_an_agent_idle_on_a_plan_that_still_has_work_gets_it_again(gs):
     resent = [p for p in gs.sent if p.uav_id == "uav-1"]
     assert len(resent) == 1 and resent[0].epoch > plan.epoch
     assert [t.task_id for t in resent[0].tasks][:2] == [t.task_id for t in plan.tasks][:2]
+
+
+def watched_by_one(gs: Harness) -> tuple[str, list]:
+    submit(gs, MonitorAction(worker_id="W2", uavs=1, standoff_m=4, duration_s=120), "watch")
+    uav = next(
+        u for u in ALL if any(isinstance(t, MonitorTask) for t in gs.replanner.plans[u].tasks)
+    )
+    return uav, list(gs.replanner.plans[uav].tasks)
+
+
+def test_a_late_outcome_of_an_earlier_task_with_the_same_id_is_stale(gs):
+    """Agents re-deliver recent outcomes when the ground station's token comes
+    back; ``uav-N.home`` of an earlier plan must not end the current one's home
+    (and, with it, everything before it in the plan)."""
+    uav, tasks = watched_by_one(gs)
+    home = tasks[-1]
+    assert isinstance(home, GoHomeTask)
+    epoch = gs.replanner.plans[uav].epoch
+    gs.manager.reports.on_outcome(
+        TaskOutcome(
+            uav_id=uav,
+            task_id=home.task_id,
+            action_id=None,
+            epoch=epoch - 1,
+            result=OutcomeResult.COMPLETED,
+        )
+    )
+    assert [t.task_id for t in gs.replanner.plans[uav].tasks] == [t.task_id for t in tasks]
+    assert [e for e in gs.events if e.detail == f"stale outcome {home.task_id} completed"]
+
+
+def test_an_outcome_under_an_older_epoch_still_counts_for_a_task_carried_over(gs):
+    uav, tasks = watched_by_one(gs)
+    epoch = gs.replanner.plans[uav].epoch
+    gs.replanner.resend(uav)
+    gs.manager.replan("resend")  # same work, a new epoch the agent has not heard yet
+    assert gs.replanner.plans[uav].epoch > epoch
+    segment = next(t for t in tasks if isinstance(t, MonitorTask))
+    gs.now = segment.end_s
+    gs.manager.reports.on_outcome(
+        TaskOutcome(
+            uav_id=uav,
+            task_id=segment.task_id,
+            action_id="watch",
+            epoch=epoch,
+            result=OutcomeResult.COMPLETED,
+            flown_s=segment.duration_s,
+        )
+    )
+    assert gs.store.action("watch").state == ActionState.COMPLETED
