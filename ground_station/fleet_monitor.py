@@ -7,6 +7,8 @@ it is *lost* and its work goes to others; when token and telemetry return it
 is *back*. A UAV whose telemetry says it crashed, or whose agent says it
 failed, is reported at once, without the grace, and takes no work until it
 reports otherwise. UAVs never heard since start-up begin as lost (without an event).
+A present UAV silent for ``SILENT_AFTER_S`` or more is shown as silent (with
+how long) until it is heard again or declared lost.
 Time is injected: :meth:`FleetMonitor.check` is called with the clock's now.
 """
 
@@ -25,6 +27,10 @@ _FROM_AGENT = {
     AgentState.EMERGENCY: UavOpState.EMERGENCY,
     AgentState.FAILED: UavOpState.FAILED,
 }
+
+
+SILENT_AFTER_S = 1.0
+"""Silence (s) after which a present UAV is shown as silent: several telemetry periods."""
 
 
 class Change(enum.StrEnum):
@@ -63,6 +69,7 @@ class FleetMonitor:
     def __init__(self, uav_ids: list[str], link_timeout_s: float) -> None:
         self.link_timeout_s = link_timeout_s
         self._uavs = {uav_id: _Uav() for uav_id in uav_ids}
+        self._checked_s: float | None = None  # the clock at the last check
 
     def known(self, uav_id: str) -> bool:
         """Whether ``uav_id`` belongs to the fleet."""
@@ -99,6 +106,7 @@ class FleetMonitor:
 
     def check(self, now_s: float) -> list[tuple[str, Change]]:
         """Apply the timeout; return the UAVs that became lost or came back."""
+        self._checked_s = now_s
         changes: list[tuple[str, Change]] = []
         for uav_id, uav in self._uavs.items():
             down = _down(uav)
@@ -141,7 +149,19 @@ class FleetMonitor:
         """Every UAV's state for a :class:`proto.rpc.FleetReply`."""
         return [
             UavState(
-                uav_id=uav_id, state=self.state(uav_id), telemetry=uav.telemetry, status=uav.status
+                uav_id=uav_id,
+                state=self.state(uav_id),
+                telemetry=uav.telemetry,
+                status=uav.status,
+                silent_s=self._silent_s(uav_id),
             )
             for uav_id, uav in self._uavs.items()
         ]
+
+    def _silent_s(self, uav_id: str) -> float | None:
+        """How long a present UAV has been silent, as of the last check, if
+        for ``SILENT_AFTER_S`` or more."""
+        if self._checked_s is None or self._uavs[uav_id].lost:
+            return None
+        silence = self.silence_s(uav_id, self._checked_s)
+        return round(silence, 1) if silence >= SILENT_AFTER_S else None

@@ -127,6 +127,10 @@ class UavState(Record, frozen=True, kw_only=True):
     state: UavOpState
     telemetry: Telemetry | None = None
     status: AgentStatus | None = None
+    silent_s: float | None = None
+    """Seconds the UAV has been silent, while it is silent but within the
+    link timeout (not yet lost); None when heard normally or already lost.
+    Its tasks' fate is unknown meanwhile, not failed."""
 
 
 class ActionReply(Message, frozen=True, kw_only=True, tag="action"):

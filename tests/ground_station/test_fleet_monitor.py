@@ -87,3 +87,19 @@ def test_unknown_uavs_are_ignored():
     monitor.on_telemetry(telemetry("intruder"), 0.0)
     assert not monitor.known("intruder")
     assert [s.uav_id for s in monitor.snapshot()] == ["u1"]
+
+
+def test_a_silent_uav_shows_how_long_it_has_been_silent_until_heard_or_lost():
+    monitor = FleetMonitor(["u1"], 5.0)
+    present(monitor, "u1", 0.0)
+    monitor.check(0.5)
+    assert monitor.snapshot()[0].silent_s is None  # heard half a second ago: normal
+    monitor.check(3.0)
+    (shown,) = monitor.snapshot()
+    assert shown.state != UavOpState.LOST and shown.silent_s == pytest.approx(3.0)
+    present(monitor, "u1", 3.5)
+    monitor.check(3.6)
+    assert monitor.snapshot()[0].silent_s is None
+    monitor.check(9.0)
+    (lost,) = monitor.snapshot()
+    assert lost.state == UavOpState.LOST and lost.silent_s is None
