@@ -9,6 +9,7 @@ import os
 import pathlib
 import secrets
 import shutil
+import signal
 import subprocess
 import sys
 import time
@@ -166,13 +167,23 @@ class Stack:
         cid = self.container(service)
         run(["docker", "network", "connect", "--alias", service, self.bus_network, cid])
 
-    def kill(self, service: str) -> None:
-        """``docker kill -s KILL`` the service's container."""
-        run(["docker", "kill", "-s", "KILL", self.container(service)])
+    def crash(self, service: str) -> None:
+        """SIGKILL the main process of ``service``'s container from the host: a
+        crash, not an operator's stop (``docker kill`` would be one, and
+        restart policies leave stopped containers alone)."""
+        pid = self._inspect(service, "{{.State.Pid}}")
+        assert pid.isdigit() and int(pid) > 0, f"{service} is not running ({pid})"
+        os.kill(int(pid), signal.SIGKILL)
 
-    def start(self, service: str) -> None:
-        """Start the (stopped) container of ``service`` again."""
-        run(["docker", "start", self.container(service)])
+    def restarts(self, service: str) -> int:
+        """How often Docker's restart policy has restarted ``service``."""
+        return int(self._inspect(service, "{{.RestartCount}}"))
+
+    def running(self, service: str) -> bool:
+        return self._inspect(service, "{{.State.Running}}") == "true"
+
+    def _inspect(self, service: str, template: str) -> str:
+        return run(["docker", "inspect", "-f", template, self.container(service)]).stdout.strip()
 
     # -- gateway ---------------------------------------------------------------
 
