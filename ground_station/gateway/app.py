@@ -13,6 +13,7 @@ import msgspec
 from fastapi import FastAPI, Request, Response
 from fastapi.responses import PlainTextResponse, StreamingResponse
 
+from ground_station.gateway import console
 from ground_station.gateway.bodies import GestureBody, ModifyBody, SubmitEnvelope
 from ground_station.gateway.errors import (
     HttpError,
@@ -46,6 +47,14 @@ from proto.sim import SimFault
 from proto.site import Site
 
 PUBLIC_PATHS = ("/healthz", "/docs", "/openapi.json", "/docs/oauth2-redirect")
+"""Prefixes served without the token. The console's page (exactly ``/``) and
+its assets (``/console/...``) are public too, see :func:`console.is_public`;
+``/`` is not a prefix here, or every path would be public."""
+
+
+def is_public(path: str) -> bool:
+    """Whether ``path`` needs no bearer token."""
+    return path.startswith(PUBLIC_PATHS) or console.is_public(path)
 
 
 def create_app(
@@ -62,7 +71,7 @@ def create_app(
 
     @app.middleware("http")
     async def guard(request: Request, call_next: Callable[[Request], Awaitable[Response]]):
-        if not request.url.path.startswith(PUBLIC_PATHS):
+        if not is_public(request.url.path):
             sent = request.headers.get("authorization", "")
             if not secrets.compare_digest(sent.encode(), f"Bearer {settings.token}".encode()):
                 counters.count(401)
@@ -172,6 +181,10 @@ def create_app(
         fault = decode_body(await body(request), SimFault)
         return json(await client.fault(fault))
 
+    @app.get("/v1/site", summary="The site: towers, lines, stations, tool stations, workers")
+    async def get_site() -> Response:
+        return json(site)
+
     @app.get("/healthz", summary="Gateway liveness and whether the ground station is up")
     async def healthz() -> Response:
         up = client.ground_station_up()
@@ -187,6 +200,7 @@ def create_app(
             prometheus_text(values, counters), media_type="text/plain; version=0.0.4"
         )
 
+    console.mount(app)
     _with_body_components(app)
     return app
 
