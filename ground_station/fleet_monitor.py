@@ -6,7 +6,8 @@ telemetry. A UAV silent (token gone, or no telemetry) for less than
 it is *lost* and its work goes to others; when token and telemetry return it
 is *back*. A UAV whose telemetry says it crashed, or whose agent says it
 failed, is reported at once, without the grace, and takes no work until it
-reports otherwise. UAVs never heard since start-up begin as lost (without an event).
+reports otherwise (then it is *back*). UAVs never heard since start-up begin
+as lost (without an event).
 A present UAV silent for ``SILENT_AFTER_S`` or more is shown as silent (with
 how long) until it is heard again or declared lost.
 Time is injected: :meth:`FleetMonitor.check` is called with the clock's now.
@@ -112,6 +113,11 @@ class FleetMonitor:
             down = _down(uav)
             if down is not None and uav.down is None and not uav.lost:
                 changes.append((uav_id, down))
+            elif down is None and uav.down is not None and not uav.lost:
+                # its reports are healthy again (e.g. a restarted agent that
+                # reported failed until its autopilot answered): back, so that
+                # it gets a fresh plan instead of flying the one it resynced
+                changes.append((uav_id, Change.BACK))
             uav.down = down
             silent = self.silence_s(uav_id, now_s) >= self.link_timeout_s
             if silent and not uav.lost:

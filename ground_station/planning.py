@@ -345,11 +345,30 @@ def _point(xyz: tuple[float, float, float]) -> Point:
     return Point(x_m=xyz[0], y_m=xyz[1], z_m=xyz[2])
 
 
+SAME_WAIT_S = 1.0
+"""Wait deadlines this close ask the same of a UAV."""
+
+SAME_SEGMENT_S = 5.0
+"""Monitoring segments whose start and end move by no more than this ask the
+same: estimates jitter from replan to replan; a segment cut short (the UAV
+must leave earlier, another takes the rest) is new work and must be sent, or
+two UAVs would hold the slot at once."""
+
+
 def same_work(a: list[Task], b: list[Task]) -> bool:
-    """Whether two task lists ask the same of a UAV (ids in order, and wait
-    deadlines within a second): if so, nothing is re-sent."""
-    return _signature(a) == _signature(b)
+    """Whether two task lists ask the same of a UAV (ids in order, wait
+    deadlines and monitoring windows within their slack): if so, nothing is
+    re-sent."""
+    return [t.task_id for t in a] == [t.task_id for t in b] and all(map(_same_task, a, b))
 
 
-def _signature(tasks: list[Task]) -> list[tuple[str, int]]:
-    return [(t.task_id, round(t.until_s) if isinstance(t, WaitTask) else 0) for t in tasks]
+def _same_task(a: Task, b: Task) -> bool:
+    if isinstance(a, WaitTask) and isinstance(b, WaitTask):
+        return abs(a.until_s - b.until_s) <= SAME_WAIT_S
+    if isinstance(a, MonitorTask) and isinstance(b, MonitorTask):
+        starts = (a.end_s - a.duration_s, b.end_s - b.duration_s)
+        return (
+            abs(a.end_s - b.end_s) <= SAME_SEGMENT_S
+            and abs(starts[0] - starts[1]) <= SAME_SEGMENT_S
+        )
+    return True

@@ -103,3 +103,20 @@ def test_a_silent_uav_shows_how_long_it_has_been_silent_until_heard_or_lost():
     monitor.check(9.0)
     (lost,) = monitor.snapshot()
     assert lost.state == UavOpState.LOST and lost.silent_s is None
+
+
+def test_an_agent_that_reported_failed_and_recovers_is_back():
+    """A restarted agent may report failed until its autopilot answers; once
+    it reports healthy it must get a fresh plan (a BACK), not go on with the
+    plan it resynced while it could take no work."""
+    monitor = FleetMonitor(["u1"], 5.0)
+    present(monitor, "u1", 0.0)
+    monitor.check(0.0)
+    monitor.on_status(AgentStatus(uav_id="u1", stamp_s=1, state=AgentState.FAILED))
+    assert monitor.check(1.0) == [("u1", Change.FAILED)]
+    assert monitor.check(1.5) == []
+    present(monitor, "u1", 2.0)
+    monitor.on_status(AgentStatus(uav_id="u1", stamp_s=2, state=AgentState.BUSY))
+    assert monitor.check(2.0) == [("u1", Change.BACK)]
+    assert monitor.available("u1")
+    assert monitor.check(2.5) == []
