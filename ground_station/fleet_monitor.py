@@ -27,6 +27,7 @@ _FROM_AGENT = {
     AgentState.RECHARGING: UavOpState.RECHARGING,
     AgentState.EMERGENCY: UavOpState.EMERGENCY,
     AgentState.FAILED: UavOpState.FAILED,
+    AgentState.NOT_READY: UavOpState.NOT_READY,
 }
 
 

@@ -26,7 +26,7 @@ from onboard_agent.surroundings import Surroundings
 from proto.errors import LinecrewError
 from proto.plan import Plan
 from proto.scenario import Scenario
-from proto.telemetry import AgentState, AgentStatus, HumanPose, Telemetry
+from proto.telemetry import AgentState, AgentStatus, FlightState, HumanPose, Telemetry
 
 log = logging.getLogger(__name__)
 
@@ -118,9 +118,21 @@ class Agent:
             return AgentState.EMERGENCY, ctx.emergency
         if ctx.recharging or (self.root.tip() is not None and "Recharge" in self.active_path()):
             return AgentState.RECHARGING, ""
+        why = self.not_ready()
+        if why:
+            state = AgentState.IDLE if self.mission.head is None else AgentState.BUSY
+            return (AgentState.NOT_READY if ctx.config.not_ready_state else state), why
         if self.mission.head is None:
             return AgentState.IDLE, ""
         return AgentState.BUSY, ""
+
+    def not_ready(self) -> str:
+        """Why the UAV, on the ground and disarmed, could not take off now ("" if it could)."""
+        vehicle = self.ctx.vehicle
+        if vehicle.armed or not (vehicle.landed or vehicle.flight_state is FlightState.UNKNOWN):
+            return ""
+        why = vehicle.not_ready_reason
+        return f"not ready: {why}" if why else ""
 
     def status(self) -> AgentStatus:
         state, reason = self.state()
@@ -135,6 +147,7 @@ class Agent:
             active_path=self.active_path(),
             queue_length=len(self.mission.tasks),
             reason=reason,
+            ready=not self.not_ready() and state is not AgentState.FAILED,
         )
 
     def status_changed(self, status: AgentStatus) -> bool:
@@ -146,6 +159,7 @@ class Agent:
             status.task_id,
             status.queue_length,
             status.reason,
+            status.ready,
             tuple(status.active_path),
         )
         changed = key != self._last_status

@@ -75,7 +75,11 @@ def step_wh(ctx: Context) -> tuple[float, Point]:
 
 
 def battery_enough(ctx: Context) -> bool:
-    """Enough energy for the next step, then the nearest station, with the reserve."""
+    """Enough energy for the next step, then the nearest station, with the
+    reserve. An unknown battery or position is no verdict: a UAV that does
+    not know them is not ready and stays on the ground (see "Go near")."""
+    if not ctx.vehicle.battery_known or not ctx.vehicle.known:
+        return True
     step, end = step_wh(ctx)
     needed = step + to_station_wh(ctx, end) + ctx.energy.reserve_wh
     return available_wh(ctx) >= needed
@@ -83,7 +87,8 @@ def battery_enough(ctx: Context) -> bool:
 
 def can_reach_station(ctx: Context) -> bool:
     """Enough energy to reach the nearest station now and keep the reserve."""
-    if not ctx.vehicle.known or ctx.vehicle.landed:
-        return True  # a landed UAV draws nothing: it recharges instead
+    vehicle = ctx.vehicle
+    if not vehicle.known or not vehicle.battery_known or vehicle.landed:
+        return True  # unknown is no emergency; a landed UAV draws nothing: it recharges instead
     needed = to_station_wh(ctx, ctx.vehicle.position) + ctx.energy.reserve_wh
     return available_wh(ctx) >= needed

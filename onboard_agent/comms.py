@@ -85,7 +85,8 @@ class Comms:
     async def _telemetry(self) -> None:
         period = 1.0 / self.config.telemetry_hz
         while True:
-            if self.agent.ctx.vehicle.known:
+            vehicle = self.agent.ctx.vehicle
+            if vehicle.known and vehicle.battery_known:  # never 0 N 0 E, never a 0 % guess
                 self.bus.publish(self.keys.telemetry(self.uav_id), self.agent.telemetry())
             await asyncio.sleep(period)
 

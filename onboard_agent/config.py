@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import dataclasses
 import os
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 
 ENV_PREFIX = "LINECREW_AGENT_"
 
@@ -38,6 +38,12 @@ class AgentConfig:
     handover_hold_m: float = 3.0  # a relief holds this much farther out until its window begins
     goto_resend_s: float = 1.0  # repeat a position target this often (no ACK exists)
     task_attempts: int = 3  # a task whose subtree failed this often is reported failed
+    arm_attempts: int = 6  # arm / mode / takeoff refusals retried (with backoff) before failing
+    retry_backoff_s: float = 1.0  # first wait after a refusal (mission s); doubles each time
+    retry_backoff_max_s: float = 16.0  # longest wait between two tries
+    ready_timeout_s: float = 120.0  # a task waits this long for the autopilot to become ready
+    not_ready_state: bool = False  # publish AgentState.NOT_READY (a gs that maps it is needed);
+    # otherwise the status keeps IDLE / BUSY with ready=False and the reason
     command_ack_timeout_s: float = 1.0  # wait this long for a COMMAND_ACK
     command_retries: int = 3  # resend an unacknowledged command this many times
     heartbeat_timeout_s: float = 3.0  # no autopilot HEARTBEAT this long -> link lost
@@ -52,7 +58,9 @@ class AgentConfig:
         for field in dataclasses.fields(cls):
             raw = env.get(ENV_PREFIX + field.name.upper())
             if raw is not None:
-                kind = int if field.type in ("int", int) else float
+                kind: Callable[[str], object] = int if field.type in ("int", int) else float
+                if field.type in ("bool", bool):
+                    kind = _boolean
                 try:
                     values[field.name] = kind(raw)
                 except ValueError as exc:
@@ -72,3 +80,14 @@ class AgentConfig:
             raise ValueError("timeouts must be positive")
         if self.command_retries < 0:
             raise ValueError("command_retries must be >= 0")
+        if self.arm_attempts < 1 or self.retry_backoff_s <= 0 or self.ready_timeout_s <= 0:
+            raise ValueError("arm_attempts, retry_backoff_s and ready_timeout_s must be positive")
+
+
+def _boolean(raw: str) -> bool:
+    text = raw.strip().lower()
+    if text in ("1", "true", "yes", "on"):
+        return True
+    if text in ("0", "false", "no", "off", ""):
+        return False
+    raise ValueError(f"not a boolean: {raw!r}")

@@ -56,7 +56,7 @@ class Mission:
             log.warning("rejected a plan for %s", plan.uav_id, extra={"uav_id": self.uav_id})
             for task in plan.tasks:
                 reason = f"plan for {plan.uav_id} sent to {self.uav_id}"
-                self._report(task, OutcomeResult.FAILED, reason, plan.epoch)
+                self._report(task, OutcomeResult.FAILED, reason, plan.epoch, code="wrong_uav")
             return PlanVerdict.REJECTED
         if plan.epoch <= self.epoch:
             log.info("ignored plan epoch %d (holding %d)", plan.epoch, self.epoch)
@@ -64,7 +64,8 @@ class Mission:
         kept = {t.task_id for t in plan.tasks}
         head = self.head
         if head is not None and head.task_id in self._started and head.task_id not in kept:
-            self._report(head, OutcomeResult.ABORTED, f"replaced by plan epoch {plan.epoch}")
+            reason = f"replaced by plan epoch {plan.epoch}"
+            self._report(head, OutcomeResult.ABORTED, reason, code="replaced")
         self.epoch = plan.epoch
         self.tasks.clear()
         for task in plan.tasks:
@@ -72,7 +73,8 @@ class Mission:
             if problem is None:
                 self.tasks.append(task)
             else:
-                self._report(task, OutcomeResult.FAILED, f"rejected: {problem}")
+                reason = f"rejected: {problem}"
+                self._report(task, OutcomeResult.FAILED, reason, code="invalid_task")
         log.info("plan epoch %d: %d tasks", plan.epoch, len(self.tasks))
         return PlanVerdict.ACCEPTED
 
@@ -133,16 +135,20 @@ class Mission:
         self._pop(task)
         self._report(task, OutcomeResult.COMPLETED, "", progress=1.0)
 
-    def fail(self, task: Task, reason: str) -> None:
-        """``task`` (the head) failed: report it and move on."""
+    def fail(
+        self, task: Task, reason: str, *, code: str = "task_failed", retryable: bool = False
+    ) -> None:
+        """``task`` (the head) failed: report it and move on. ``retryable``:
+        for a passing reason (it may succeed later or on another UAV)."""
         self._pop(task)
-        self._report(task, OutcomeResult.FAILED, reason)
+        self._report(task, OutcomeResult.FAILED, reason, code=code, retryable=retryable)
 
     def abandon(self, reason: str) -> int:
-        """Empty the queue (emergency protocol): every task fails with ``reason``."""
+        """Empty the queue (emergency protocol): every task fails with
+        ``reason``; retryable, as another UAV (or this one later) can do it."""
         count = len(self.tasks)
         while self.tasks:
-            self.fail(self.tasks[0], reason)
+            self.fail(self.tasks[0], reason, code="abandoned", retryable=True)
         return count
 
     def take_outcomes(self) -> list[TaskOutcome]:
@@ -170,6 +176,9 @@ class Mission:
         reason: str,
         epoch: int | None = None,
         progress: float | None = None,
+        *,
+        code: str = "",
+        retryable: bool = False,
     ) -> None:
         outcome = TaskOutcome(
             uav_id=self.uav_id,
@@ -183,6 +192,15 @@ class Mission:
             stamp_s=self.wall(),
             flown_s=self.monitored_s(task.task_id),
             tool=self._tools.get(task.task_id),
+            retryable=retryable,
+            reason_code=code,
         )
-        log.info("task %s %s %s", task.task_id, result, reason, extra={"uav_id": self.uav_id})
+        log.info(
+            "task %s %s %s%s",
+            task.task_id,
+            result,
+            reason,
+            " (retryable)" if retryable else "",
+            extra={"uav_id": self.uav_id},
+        )
         self.outbox.append(outcome)

@@ -116,6 +116,7 @@ class UavOpState(enum.StrEnum):
     BUSY = "busy"
     RECHARGING = "recharging"
     EMERGENCY = "emergency"
+    NOT_READY = "not_ready"  # present, its autopilot cannot arm yet: takes no new work
     LOST = "lost"
     FAILED = "failed"
 

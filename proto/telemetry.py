@@ -46,6 +46,7 @@ class AgentState(enum.StrEnum):
     RECHARGING = "recharging"
     EMERGENCY = "emergency"
     FAILED = "failed"
+    NOT_READY = "not_ready"  # autopilot up but cannot arm yet (GPS, EKF, home, pre-arm)
 
 
 class AgentStatus(Message, frozen=True, kw_only=True):
@@ -60,6 +61,7 @@ class AgentStatus(Message, frozen=True, kw_only=True):
     active_path: list[str] = []
     queue_length: Count = 0
     reason: str = ""
+    ready: bool = True  # False while the autopilot cannot arm (``reason`` says why)
 
 
 class OutcomeResult(enum.StrEnum):
@@ -79,6 +81,12 @@ class TaskOutcome(Message, frozen=True, kw_only=True):
     the time spent on station for a monitoring task, measured on board: the
     ground station credits that, not the planned duration. ``tool`` is the
     tool the gripper grabbed (pick) or released (drop), as the agent saw it.
+    ``retryable`` marks a failure for a passing reason (the autopilot was not
+    ready or refused to arm, a command timed out, an emergency emptied the
+    queue): the same task can succeed later or on another UAV. Otherwise a
+    failure is permanent. ``reason_code`` is a short machine-readable code
+    (``not_ready``, ``arm_refused``, ``command_timeout``, ``abandoned``,
+    ``invalid_task``, ``wrong_uav``, ``task_failed``; "" when completed).
     """
 
     uav_id: Id
@@ -92,6 +100,8 @@ class TaskOutcome(Message, frozen=True, kw_only=True):
     stamp_s: float = 0.0
     flown_s: NonNegative = 0.0
     tool: Id | None = None
+    retryable: bool = False
+    reason_code: str = ""
 
 
 class HumanPose(Message, frozen=True, kw_only=True):

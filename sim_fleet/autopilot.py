@@ -32,6 +32,8 @@ CMD_NAV_TAKEOFF = 22
 CMD_DO_SET_MODE = 176
 CMD_DO_CHANGE_SPEED = 178
 CMD_DO_GRIPPER = 211
+CMD_DO_REPOSITION = 192
+REPOSITION_CHANGE_MODE = 1  # MAV_DO_REPOSITION_FLAGS_CHANGE_MODE
 CMD_COMPONENT_ARM_DISARM = 400
 
 FORCE_MAGIC = 21196  # param2 of ARM_DISARM that skips checks
@@ -92,14 +94,17 @@ def as_int(x: float) -> int:
 
 
 def arm(vehicle: Vehicle, *, forced: bool = False) -> Outcome:
+    """AP_Arming_Copter::arm: every failing pre-arm check is reported (one
+    STATUSTEXT each), the ACK is FAILED. A forced arm skips all but the motors."""
     if vehicle.armed:
         return ACCEPTED
-    if vehicle.state in (FlightState.CRASHED, FlightState.FALLING) or vehicle.motors_failed:
-        return Outcome(Result.FAILED, "PreArm: Motors: check failed")
+    failures = vehicle.prearm_failures()
+    if forced:
+        failures = [f for f in failures if f.startswith("PreArm: Motors")]
+    if failures:
+        return Outcome(Result.FAILED, "\n".join(failures))
     if vehicle.mode not in ARMABLE_MODES:
         return Outcome(Result.FAILED, "Arm: Mode not armable")
-    if not forced and vehicle.battery.soc < vehicle.params.arm_min_soc:
-        return Outcome(Result.FAILED, "PreArm: Battery 1 below minimum arming capacity")
     vehicle.arm()
     vehicle.say(Severity.INFO, "Arming motors")
     return ACCEPTED
@@ -164,6 +169,8 @@ def gripper(vehicle: Vehicle, action: int, tools: ToolHooks) -> Outcome:
     """DO_GRIPPER param2: 0 release, 1 grab. Vehicles without one: UNSUPPORTED."""
     if not vehicle.has_gripper:
         return Outcome(Result.UNSUPPORTED, "Gripper: not fitted")
+    if vehicle.parameters.get("GRIP_ENABLE") != 1:
+        return Outcome(Result.FAILED, "Gripper: not enabled (GRIP_ENABLE 0)")
     if action not in (0, 1):
         return FAILED
     if vehicle.gripper_failed:
@@ -171,6 +178,39 @@ def gripper(vehicle: Vehicle, action: int, tools: ToolHooks) -> Outcome:
     text = tools.grab(vehicle) if action == 1 else tools.release(vehicle)
     vehicle.say(Severity.INFO, text)
     return ACCEPTED
+
+
+def reposition(vehicle: Vehicle, target: Vec3 | None, flags: int) -> Outcome:
+    """DO_REPOSITION (GCS_MAVLINK_Copter::handle_command_int_do_reposition):
+    outside GUIDED only with the change-mode flag; the vehicle must be flying."""
+    change_mode = bool(flags & REPOSITION_CHANGE_MODE)
+    if vehicle.mode is not Mode.GUIDED and not change_mode:
+        return DENIED
+    if target is None:
+        return DENIED
+    if vehicle.state not in (FlightState.FLYING, FlightState.TAKING_OFF) or not vehicle.armed:
+        return FAILED
+    if vehicle.mode is not Mode.GUIDED:
+        vehicle.enter_mode(Mode.GUIDED)
+    vehicle.fly_to(target)
+    return ACCEPTED
+
+
+def set_param(vehicle: Vehicle, name: str, value: float) -> bool:
+    """PARAM_SET: store the value and apply the few that act at once."""
+    if not math.isfinite(value):
+        return False
+    p = vehicle.parameters.store(name, value)
+    if p is None:
+        return False
+    t = vehicle.type
+    if name == "WPNAV_SPEED" and value > 0:
+        vehicle.speed_mps = min(value / 100.0, t.speed_cap_mps)
+    elif name == "WPNAV_SPEED_UP" and value > 0:
+        vehicle.climb_mps = min(value / 100.0, 2.0 * t.climb_rate_mps)
+    elif name == "WPNAV_SPEED_DN" and value > 0:
+        vehicle.descent_mps = min(value / 100.0, 2.0 * t.descent_rate_mps)
+    return True
 
 
 def position_target(vehicle: Vehicle, position: Vec3 | None, velocity: Vec3 | None) -> None:

@@ -16,6 +16,7 @@ import time
 from linecrew.scenarios import load, with_fleet_size
 from sim_fleet.fleet import Fleet, FleetConfig, FleetThread
 from sim_fleet.from_proto import scenario_from_proto
+from sim_fleet.streams import TelemetryRates
 
 
 class _Sink:
@@ -49,7 +50,11 @@ def run(vehicles: int, seconds: float, rate_hz: float, speedup: float) -> dict[s
     """Simulate ``vehicles`` for ``seconds`` of wall time; returns the numbers."""
     sink = _Sink()
     config = FleetConfig(
-        speedup=speedup, rate_hz=rate_hz, base_port=0, static_peers=(sink.sock.getsockname(),)
+        speedup=speedup,
+        rate_hz=rate_hz,
+        base_port=0,
+        static_peers=(sink.sock.getsockname(),),
+        rates=TelemetryRates(stream_by_default=True),  # the sink never asks
     )
     scenario = with_fleet_size(load("paper"), vehicles)
     fleet = Fleet(scenario_from_proto(scenario.site, scenario.fleet), config)

@@ -22,8 +22,10 @@ from proto.sim import GetSimState, SimFault
 from sim_fleet.faults import apply_fault
 from sim_fleet.fleet import Fleet, FleetConfig
 from sim_fleet.from_proto import scenario_from_proto
+from sim_fleet.streams import TelemetryRates
 from sim_fleet.tracker import HumanTracker
 from sim_fleet.truth import sim_state
+from sim_fleet.vehicle import AutopilotParams
 
 log = logging.getLogger("linecrew.sim")
 
@@ -75,7 +77,21 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--host", default="127.0.0.1", help="address the endpoints bind to")
     parser.add_argument("--pose-hz", type=float, default=4.0, help="worker pose rate")
     parser.add_argument("--id", default="sim", help="liveliness token name")
+    parser.add_argument(
+        "--warmup-s",
+        type=float,
+        default=AutopilotParams.warmup_s,
+        help="GPS/EKF warm-up before arming is allowed, in simulated seconds "
+        "(scaled by --speedup like everything else; 0 skips it)",
+    )
+    parser.add_argument(
+        "--stream-by-default",
+        action="store_true",
+        help="stream telemetry before any client asks (ArduCopter with SRx_ rates set)",
+    )
     args = parser.parse_args(argv)
+    if args.warmup_s < 0:
+        parser.error("--warmup-s must be >= 0")
     bus_config = start(args, "sim")
     shutdown = Shutdown().install()
     try:
@@ -84,7 +100,13 @@ def main(argv: list[str] | None = None) -> int:
     except (ScenarioError, Unavailable) as exc:
         log.error("simulator cannot start: %s", exc)
         return 1
-    config = FleetConfig(speedup=args.speedup, base_port=args.base_port, host=args.host)
+    config = FleetConfig(
+        speedup=args.speedup,
+        base_port=args.base_port,
+        host=args.host,
+        params=AutopilotParams(warmup_s=args.warmup_s),
+        rates=TelemetryRates(stream_by_default=args.stream_by_default),
+    )
     fleet = Fleet(scenario_from_proto(scenario.site, scenario.fleet), config)
     with bus:
         code = asyncio.run(serve(scenario, fleet, bus, shutdown, args.id, args.pose_hz))

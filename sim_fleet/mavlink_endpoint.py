@@ -47,8 +47,14 @@ CAPABILITIES = (
     | mav.MAV_PROTOCOL_CAPABILITY_SET_POSITION_TARGET_GLOBAL_INT
     | mav.MAV_PROTOCOL_CAPABILITY_MAVLINK2
 )
-SENSORS = 0x1 | 0x2 | 0x4 | 0x8 | 0x20 | 0x8000 | 0x2000000  # gyro..gps, motors, battery
+SENSOR_GPS = 0x20
+SENSOR_AHRS = 0x200000
 SENSOR_BATTERY = 0x2000000
+SENSOR_PREARM = 0x10000000  # MAV_SYS_STATUS_PREARM_CHECK: healthy when armable
+SENSORS = 0x1 | 0x2 | 0x4 | 0x8 | SENSOR_GPS | 0x8000 | SENSOR_AHRS | SENSOR_BATTERY | SENSOR_PREARM
+# EKF_STATUS_REPORT flags: attitude, velocities, positions (rel/abs, horiz/vert), predicted
+EKF_GOOD = 0x1 | 0x2 | 0x4 | 0x8 | 0x10 | 0x20 | 0x100 | 0x200
+EKF_NO_GPS = 0x1 | 0x4 | 0x80  # attitude, vertical velocity, constant position mode
 UINT16_MAX = 65535
 
 Addr = tuple[str, int]
@@ -71,6 +77,7 @@ class VehicleEndpoint(asyncio.DatagramProtocol):
         self.bad_datagrams = 0
         self._logged_bad: set[str] = set()
         self._mav = mav.MAVLink(None, srcSystem=vehicle.sysid, srcComponent=AUTOPILOT_COMPONENT)
+        self._home_sent = 0  # the vehicle's home_version last broadcast
         self._transport: asyncio.DatagramTransport | None = None
 
     # ---- asyncio protocol ------------------------------------------------
@@ -155,6 +162,26 @@ class VehicleEndpoint(asyncio.DatagramProtocol):
                 self._global_target(msg)
             case "SET_POSITION_TARGET_LOCAL_NED" if self._for_me(msg):
                 self._local_target(msg)
+            case "REQUEST_DATA_STREAM" if self._for_me(msg):
+                rate = float(msg.req_message_rate)
+                self.schedule.request_data_stream(msg.req_stream_id, rate, bool(msg.start_stop))
+            case "PARAM_REQUEST_LIST" if self._for_me(msg):
+                for param in self.vehicle.parameters.all():
+                    self._send_to([addr], self._param_value(param.name))
+            case "PARAM_REQUEST_READ" if self._for_me(msg):
+                params = self.vehicle.parameters
+                name = msg.param_id if msg.param_index < 0 else None
+                if name is None:
+                    by_index = params.by_index(msg.param_index)
+                    name = by_index.name if by_index is not None else None
+                if name is not None and name in params:
+                    self._send_to([addr], self._param_value(name))
+            case "PARAM_SET" if self._for_me(msg):
+                if autopilot.set_param(self.vehicle, msg.param_id, msg.param_value):
+                    peers = list(dict.fromkeys([addr, *self.static_peers, *self.peers]))
+                    self._send_to(peers, self._param_value(msg.param_id))
+                elif msg.param_id in self.vehicle.parameters:  # read-only: echo the value
+                    self._send_to([addr], self._param_value(msg.param_id))
             case _:
                 pass  # HEARTBEAT and everything else: only makes the sender a peer
 
@@ -172,6 +199,10 @@ class VehicleEndpoint(asyncio.DatagramProtocol):
                 outcome = Outcome(Result.ACCEPTED if ok else Result.FAILED)
             case mav.MAV_CMD_REQUEST_AUTOPILOT_CAPABILITIES:
                 outcome = Outcome(Result.ACCEPTED)
+            case mav.MAV_CMD_DO_REPOSITION:
+                outcome = autopilot.reposition(
+                    self.vehicle, self._reposition_target(cmd), autopilot.as_int(p[1])
+                )
             case _:
                 outcome = autopilot.handle_command(cmd, self.vehicle, self.world)
         self._ack(cmd.command, outcome, msg, addr)
@@ -186,10 +217,29 @@ class VehicleEndpoint(asyncio.DatagramProtocol):
             case mav.MAV_CMD_REQUEST_AUTOPILOT_CAPABILITIES:
                 self._send_to([addr], self._encode(streams.AUTOPILOT_VERSION))
 
+    def _reposition_target(self, cmd: autopilot.Command) -> tuple[float, float, float] | None:
+        """DO_REPOSITION's location in ENU; NaN / 0 lat-lon or altitude keep the current one."""
+        p, v = cmd.params, self.vehicle
+        if cmd.frame is None:  # COMMAND_LONG: degrees, relative altitude
+            frame, lat, lon = frames.GLOBAL_RELATIVE_ALT, p[4], p[5]
+        else:
+            frame, lat, lon = cmd.frame, p[4] / 1e7, p[5] / 1e7
+        alt = p[6]
+        here = v.position
+        if not math.isfinite(lat) or not math.isfinite(lon) or (lat == 0 and lon == 0):
+            lat, lon, _ = self.world.geo.to_geodetic(here)
+        if not math.isfinite(alt):
+            frame, alt = frames.GLOBAL_RELATIVE_ALT, here[2] - v.home[2]
+        target = frames.global_to_enu(self.world.geo, frame, lat, lon, alt)
+        if target is not None and frame not in (frames.GLOBAL, frames.GLOBAL_INT):
+            target = (target[0], target[1], target[2] + v.home[2])  # relative to home
+        return target
+
     def _ack(self, command: int, outcome: Outcome, msg: Any, addr: Addr) -> None:
         if outcome.text:
             severity = Severity.WARNING if outcome.result else Severity.INFO
-            self._send_to([addr], self._statustext(severity, outcome.text))
+            for line in outcome.text.split("\n"):
+                self._send_to([addr], self._statustext(severity, line))
         ack = self._mav.command_ack_encode(
             command, int(outcome.result), 0, 0, msg.get_srcSystem(), msg.get_srcComponent()
         )
@@ -205,6 +255,8 @@ class VehicleEndpoint(asyncio.DatagramProtocol):
             if pos is None:
                 autopilot.hold(v)
                 return
+            if msg.coordinate_frame not in (frames.GLOBAL, frames.GLOBAL_INT):
+                pos = (pos[0], pos[1], pos[2] + v.home[2])  # relative to home
         elif not msg.type_mask & VEL_IGNORE:
             vel = frames.ned_to_enu((msg.vx, msg.vy, msg.vz))
             if not all(math.isfinite(c) and abs(c) < 1000 for c in vel):
@@ -218,7 +270,7 @@ class VehicleEndpoint(asyncio.DatagramProtocol):
         pos = vel = None
         if not msg.type_mask & POS_IGNORE:
             pos = frames.local_to_enu(
-                frame, (msg.x, msg.y, msg.z), v.home, v.position, v.heading_deg
+                frame, (msg.x, msg.y, msg.z), v.origin, v.position, v.heading_deg
             )
             if pos is None:
                 autopilot.hold(v)
@@ -241,6 +293,9 @@ class VehicleEndpoint(asyncio.DatagramProtocol):
             return
         for t in texts:
             self._send_to(peers, self._statustext(int(t.severity), t.text))
+        if self.vehicle.home_set and self.vehicle.home_version != self._home_sent:
+            self._home_sent = self.vehicle.home_version  # ArduPilot announces a new home
+            self._send_to(peers, self._encode(streams.HOME_POSITION))
         for msg_id in self.schedule.due(self.world.time_s):
             self._send_to(peers, self._encode(msg_id))
 
@@ -255,6 +310,15 @@ class VehicleEndpoint(asyncio.DatagramProtocol):
                 self._transport.sendto(buf, addr)
             except OSError as exc:
                 log.debug("%s: send to %s failed: %s", self.vehicle.id, addr, exc)
+
+    def _param_value(self, name: str) -> Any:
+        params = self.vehicle.parameters
+        p = params.param(name)
+        if p is None:
+            return None
+        return self._mav.param_value_encode(
+            p.name.encode("ascii"), p.value, p.type, len(params), params.index_of(name)
+        )
 
     def _statustext(self, severity: int, text: str) -> Any:
         return self._mav.statustext_encode(severity, text.encode("ascii", "replace")[:50])
@@ -277,25 +341,48 @@ class VehicleEndpoint(asyncio.DatagramProtocol):
                     system_status(v.armed, v.state, critical),
                 )
             case streams.GLOBAL_POSITION_INT:
+                if not v.ekf_ok:  # no position yet: ArduCopter sends zeros
+                    return m.global_position_int_encode(boot_ms, 0, 0, 0, 0, 0, 0, 0, UINT16_MAX)
                 lat, lon, alt = self.world.geo.to_geodetic(pos)
                 return m.global_position_int_encode(
                     boot_ms, round(lat * 1e7), round(lon * 1e7), round(alt * 1000),
-                    round(pos[2] * 1000), round(vel[1] * 100), round(vel[0] * 100),
+                    round((pos[2] - v.home[2]) * 1000), round(vel[1] * 100), round(vel[0] * 100),
                     round(-vel[2] * 100), round(v.heading_deg * 100) % 36000,
                 )  # fmt: skip
+            case streams.GPS_RAW_INT:
+                if not v.gps_fix:
+                    return m.gps_raw_int_encode(
+                        boot_ms * 1000, 1, 0, 0, 0, UINT16_MAX, UINT16_MAX, 0, UINT16_MAX, 0
+                    )  # fix_type 1: NO_FIX
+                lat, lon, alt = self.world.geo.to_geodetic(pos)
+                cog = round(v.heading_deg * 100) % 36000
+                return m.gps_raw_int_encode(
+                    boot_ms * 1000, 3, round(lat * 1e7), round(lon * 1e7), round(alt * 1000),
+                    121, 200, round(math.hypot(vel[0], vel[1]) * 100), cog, 10,
+                )  # fmt: skip
+            case streams.EKF_STATUS_REPORT:
+                if v.ekf_ok:
+                    return m.ekf_status_report_encode(EKF_GOOD, 0.02, 0.01, 0.01, 0.02, 0.0)
+                return m.ekf_status_report_encode(EKF_NO_GPS, 0.0, 0.0, 0.0, 0.02, 0.0)
             case streams.ATTITUDE:
                 yaw = math.radians(v.heading_deg)
                 yaw = yaw - 2 * math.pi if yaw > math.pi else yaw
                 return m.attitude_encode(boot_ms, 0.0, 0.0, yaw, 0.0, 0.0, 0.0)
             case streams.VFR_HUD:
-                _, _, alt = self.world.geo.to_geodetic(pos)
+                _, _, alt = self.world.geo.to_geodetic(pos if v.ekf_ok else (0.0, 0.0, 0.0))
                 gs = math.hypot(vel[0], vel[1])
                 throttle = 50 if v.armed and v.airborne else 0
                 return m.vfr_hud_encode(gs, gs, round(v.heading_deg) % 360, throttle, alt, vel[2])
             case streams.SYS_STATUS:
-                health = (
-                    SENSORS if battery.soc > v.params.critical_soc else SENSORS & ~SENSOR_BATTERY
-                )
+                health = SENSORS
+                if battery.soc <= v.params.critical_soc:
+                    health &= ~SENSOR_BATTERY
+                if not v.gps_fix:
+                    health &= ~SENSOR_GPS
+                if not v.ekf_ok:
+                    health &= ~SENSOR_AHRS
+                if v.prearm_failures():
+                    health &= ~SENSOR_PREARM
                 return m.sys_status_encode(
                     SENSORS, SENSORS, health, 0, round(battery.voltage_v() * 1000),
                     round(battery.current_a() * 100), pct, 0, 0, 0, 0, 0, 0,
@@ -305,6 +392,8 @@ class VehicleEndpoint(asyncio.DatagramProtocol):
             case streams.EXTENDED_SYS_STATE:
                 return m.extended_sys_state_encode(0, LANDED_STATE[v.state])
             case streams.HOME_POSITION:
+                if not v.home_set:
+                    return None  # ArduPilot sends no HOME_POSITION before home is set
                 lat, lon, alt = self.world.geo.to_geodetic(v.home)
                 return m.home_position_encode(
                     round(lat * 1e7), round(lon * 1e7), round(alt * 1000), 0.0, 0.0, 0.0,

@@ -14,11 +14,13 @@ class Mode(IntEnum):
 
     STABILIZE = 0  # no sticks here: holds position in the air, armable on ground
     GUIDED = 4
+    LOITER = 5  # no sticks here: holds position
     RTL = 6
     LAND = 9
+    BRAKE = 17  # stops and holds position (MAVSDK's "hold" on ArduCopter)
 
 
-ARMABLE_MODES = frozenset({Mode.STABILIZE, Mode.GUIDED})  # ArduCopter allows_arming()
+ARMABLE_MODES = frozenset({Mode.STABILIZE, Mode.GUIDED, Mode.LOITER})  # ArduCopter allows_arming()
 TAKEOFF_MODES = frozenset({Mode.GUIDED})  # has_user_takeoff() in GUIDED
 
 

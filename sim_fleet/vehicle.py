@@ -15,6 +15,7 @@ from sim_fleet import physics
 from sim_fleet.battery import Battery
 from sim_fleet.events import Severity, StatusText
 from sim_fleet.modes import FlightState, Mode
+from sim_fleet.params import INT8, INT16, INT32, REAL32, Param, ParamStore
 from sim_fleet.scenario import ToolSpec, Vec3, VehicleSpec, VehicleType
 
 log = logging.getLogger(__name__)
@@ -35,6 +36,15 @@ class AutopilotParams:
     critical_soc: float = 0.10  # "Battery 1 is critical" warning
     auto_disarm_s: float | None = 10.0  # DISARM_DELAY: armed on the ground, not flying
     initial_mode: Mode = Mode.STABILIZE
+    # GPS/EKF warm-up after power-on, in simulated seconds (ArduCopter SITL takes
+    # ~40 s): the GPS gets its 3-D fix half-way, then the EKF uses it, sets its
+    # origin and home; until then arming fails with ArduCopter's pre-arm texts
+    # and positions read lat = lon = 0. 0 skips it (an explicit choice).
+    warmup_s: float = 3.0
+
+    def __post_init__(self) -> None:
+        if self.warmup_s < 0:
+            raise ValueError("warmup_s must be >= 0")
 
 
 class Vehicle:
@@ -53,6 +63,9 @@ class Vehicle:
         self.sysid = sysid
         self.params = params or AutopilotParams()
         self.home: Vec3 = (home[0], home[1], 0.0)
+        self.origin: Vec3 = self.home  # EKF origin (LOCAL_NED frames): the power-on spot
+        self.home_set = self.params.warmup_s <= 0
+        self.home_version = 0  # bumped when home is set or moved (HOME_POSITION goes out)
         self.position: Vec3 = self.home
         self.velocity: Vec3 = (0.0, 0.0, 0.0)
         self.heading_deg = 0.0
@@ -81,6 +94,7 @@ class Vehicle:
         self.link_down_until = 0.0
         self.gps_frozen: tuple[Vec3, Vec3] | None = None
         self.gps_frozen_until = math.inf
+        self.parameters = ParamStore(default_parameters(self))
 
     # ---- status ----------------------------------------------------------
     @property
@@ -90,6 +104,40 @@ class Vehicle:
     @property
     def has_gripper(self) -> bool:
         return self.type.gripper
+
+    @property
+    def gps_fix(self) -> bool:
+        """The GPS has a 3-D fix (half-way through the warm-up)."""
+        return self.now_s >= 0.5 * self.params.warmup_s
+
+    @property
+    def ekf_ok(self) -> bool:
+        """The EKF has an absolute position (origin and home set)."""
+        return self.home_set
+
+    def prearm_failures(self) -> list[str]:
+        """ArduCopter's pre-arm check texts that fail now (empty when armable)."""
+        failures = []
+        if self.state in (FlightState.CRASHED, FlightState.FALLING) or self.motors_failed:
+            failures.append("PreArm: Motors: check failed")
+        if self.parameters.get("ARMING_CHECK") == 0:
+            return failures
+        if not self.ekf_ok:
+            failures.append("PreArm: AHRS: waiting for home")
+        if not self.gps_fix:
+            failures.append("PreArm: GPS 1: Bad fix")
+        if self.battery.soc < self.params.arm_min_soc:
+            failures.append("PreArm: Battery 1 below minimum arming capacity")
+        return failures
+
+    @property
+    def disarm_delay_s(self) -> float | None:
+        delay = self.parameters.get("DISARM_DELAY")
+        return None if delay <= 0 else delay
+
+    @property
+    def rtl_alt_m(self) -> float:
+        return self.parameters.get("RTL_ALT") / 100.0
 
     def say(self, severity: Severity, text: str) -> None:
         log.info("%s: %s", self.id, text, extra={"uav_id": self.id})
@@ -121,6 +169,8 @@ class Vehicle:
     def arm(self) -> None:
         self.armed = True
         self._ground_armed_s = 0.0
+        self.home = self.position  # ArduCopter re-homes where it arms
+        self.home_version += 1
 
     def disarm(self, reason: str = "Disarming motors") -> None:
         if not self.armed:
@@ -144,7 +194,7 @@ class Vehicle:
         elif mode is Mode.RTL:
             self.state = FlightState.FLYING
             self.rtl_phase = "climb"
-            self._rtl_alt_m = max(self.position[2], self.params.rtl_alt_m)
+            self._rtl_alt_m = max(self.position[2], self.rtl_alt_m)
         else:
             self.state = FlightState.FLYING
             self.target = self.position  # GUIDED/STABILIZE entry: hold here
@@ -194,6 +244,8 @@ class Vehicle:
     # ---- simulation -------------------------------------------------------
     def step(self, dt_s: float, now_s: float) -> None:
         self.now_s = now_s
+        if not self.home_set and now_s >= self.params.warmup_s:
+            self._set_home()
         if self.state is FlightState.FALLING:
             self.position, self.velocity = physics.step_falling(self.position, self.velocity, dt_s)
             self.battery.load_w = 0.0
@@ -224,7 +276,7 @@ class Vehicle:
             self.disarm()
             return
         self._ground_armed_s += dt_s
-        limit = self.params.auto_disarm_s
+        limit = self.disarm_delay_s
         if limit is not None and self._ground_armed_s >= limit:
             self.disarm("Disarming motors (auto)")
 
@@ -288,6 +340,14 @@ class Vehicle:
         if math.hypot(vx, vy) > MOVING_MPS:
             self.heading_deg = math.degrees(math.atan2(vx, vy)) % 360.0
 
+    def _set_home(self) -> None:
+        """End of the warm-up: the EKF uses the GPS, sets its origin and home here."""
+        self.home_set = True
+        self.origin = self.home = self.position
+        self.home_version += 1
+        self.say(Severity.INFO, "EKF3 IMU0 is using GPS")
+        self.say(Severity.INFO, "EKF3 IMU0 origin set")
+
     def _touchdown(self) -> None:
         self.position = (self.position[0], self.position[1], 0.0)
         self.velocity = (0.0, 0.0, 0.0)
@@ -327,3 +387,24 @@ class Vehicle:
                 f"{self.battery.consumed_mah():.0f} mAh",
             )
         self._warned = max(self._warned, level)
+
+
+def default_parameters(v: Vehicle) -> list[Param]:
+    """The vehicle's parameter file: ArduCopter names and units."""
+    t, p = v.type, v.params
+    cells_v = 3.7 * t.cells
+    return [
+        Param("SYSID_THISMAV", float(v.sysid), INT16, read_only=True),
+        Param("FRAME_CLASS", 1.0, INT8, read_only=True),  # quad
+        Param("ARMING_CHECK", 1.0, INT32),
+        Param("DISARM_DELAY", float(p.auto_disarm_s or 0), INT8),
+        Param("GRIP_ENABLE", 1.0 if t.gripper else 0.0, INT8),
+        Param("RTL_ALT", round(p.rtl_alt_m * 100), INT32),
+        Param("LAND_SPEED", round(t.land_speed_mps * 100), INT16),
+        Param("WPNAV_SPEED", t.cruise_speed_mps * 100, REAL32),
+        Param("WPNAV_SPEED_UP", t.climb_rate_mps * 100, REAL32),
+        Param("WPNAV_SPEED_DN", t.descent_rate_mps * 100, REAL32),
+        Param("BATT_CAPACITY", float(round(t.battery_wh / cells_v * 1000)), INT32, read_only=True),
+        Param("BATT_ARM_MAH", 0.0, INT32),
+        Param("SIM_WARMUP_S", p.warmup_s, REAL32, read_only=True),  # not ArduCopter's: the sim's
+    ]

@@ -9,11 +9,20 @@ resending up to ``command_retries`` times; a refusal becomes
 Position targets (SET_POSITION_TARGET_GLOBAL_INT) have no ACK in MAVLink, so
 callers repeat them. A silent autopilot (no HEARTBEAT for
 ``heartbeat_timeout_s``) shows as ``state.link_ok == False``.
+
+ArduCopter streams only what it is asked for (``SRx_`` rates may be 0): on
+finding the autopilot, and again after a heartbeat loss or when positions
+stop while heartbeats go on, the link asks for its telemetry by stream group
+(REQUEST_DATA_STREAM) and per message (SET_MESSAGE_INTERVAL), including the
+readiness reports (SYS_STATUS, GPS_RAW_INT, EKF_STATUS_REPORT, HOME_POSITION).
+A GLOBAL_POSITION_INT of lat = lon = 0 (no EKF origin yet) or without a 3-D
+fix leaves the position unknown; the battery is unknown until reported.
 """
 
 from __future__ import annotations
 
 import asyncio
+import collections
 import dataclasses
 import logging
 import os
@@ -43,6 +52,7 @@ COPTER_MODES = {
     5: "LOITER",
     6: "RTL",
     9: "LAND",
+    17: "BRAKE",
 }
 MODE_NUMBERS = {name: number for number, name in COPTER_MODES.items()}
 LANDED_STATES = {
@@ -52,7 +62,23 @@ LANDED_STATES = {
     mav.MAV_LANDED_STATE_LANDING: FlightState.LANDING,
 }
 POSITION_ONLY = 0b110111111000  # SET_POSITION_TARGET type_mask: use x, y, z only
-STREAMS_HZ = {"GLOBAL_POSITION_INT": 5.0, "BATTERY_STATUS": 1.0, "EXTENDED_SYS_STATE": 1.0}
+STREAMS_HZ = {
+    "GLOBAL_POSITION_INT": 5.0,
+    "BATTERY_STATUS": 1.0,
+    "EXTENDED_SYS_STATE": 1.0,
+    "SYS_STATUS": 1.0,
+    "GPS_RAW_INT": 1.0,
+    "EKF_STATUS_REPORT": 1.0,
+    "HOME_POSITION": 0.5,
+}
+DATA_STREAMS_HZ = {  # the ArduPilot stream groups holding the above (REQUEST_DATA_STREAM)
+    mav.MAV_DATA_STREAM_EXTENDED_STATUS: 1,
+    mav.MAV_DATA_STREAM_POSITION: 5,
+    mav.MAV_DATA_STREAM_EXTRA3: 1,
+}
+PREARM_BIT = mav.MAV_SYS_STATUS_PREARM_CHECK
+ARM_TEXTS = ("PreArm:", "Arm:")  # ArduCopter's reasons for refusing to arm
+STREAMS_STALE_S = 3.0  # no position this long with heartbeats arriving: ask again
 CRASH_TEXT = "Crash:"  # ArduCopter's crash check ("Crash: Disarming")
 GRIPPER_TEXT = "Gripper:"  # what a gripper says it did (our simulator; a load sensor's driver)
 TEXT_FRESH_S = 2.0  # a STATUSTEXT this recent explains a refused command
@@ -83,12 +109,16 @@ class MavlinkLink:
         self._acks: dict[int, asyncio.Future[Any]] = {}
         self._last_heartbeat = -1e9
         self._last_text = ("", -1e9)
+        self._texts: collections.deque[tuple[str, float]] = collections.deque(maxlen=8)
         self._conn: Any = None
         self._loop: asyncio.AbstractEventLoop | None = None
         self._thread: threading.Thread | None = None
         self._closing = threading.Event()
         self._battery_status_seen = False
         self._tasks: set[asyncio.Task[Any]] = set()
+        self._last_position = -1e9
+        self._streams_asked = -1e9
+        self._streams_task: asyncio.Task[None] | None = None
 
     # -- lifecycle ---------------------------------------------------------------
 
@@ -112,6 +142,10 @@ class MavlinkLink:
             if silent and self._state.link_ok:
                 log.warning("autopilot heartbeat lost", extra={"url": self.url})
                 self._state = dataclasses.replace(self._state, link_ok=False)
+            now = self.clock()
+            starved = now - self._last_position > STREAMS_STALE_S
+            if self._state.link_ok and starved and now - self._streams_asked > STREAMS_STALE_S:
+                self._request_streams()  # a rebooted autopilot forgets what it was asked
             await asyncio.sleep(1.0)
 
     def close(self) -> None:
@@ -190,6 +224,7 @@ class MavlinkLink:
         system, component = await self._wait_target()
         p = [float(x) for x in params] + [0.0] * (7 - len(params))
         assert self._loop is not None
+        sent_at = self.clock()
         for attempt in range(self.config.command_retries + 1):
             future: asyncio.Future[Any] = self._loop.create_future()
             self._acks[command] = future
@@ -205,7 +240,7 @@ class MavlinkLink:
             if ack.result == mav.MAV_RESULT_ACCEPTED:
                 return
             result = mav.enums["MAV_RESULT"][ack.result].name.removeprefix("MAV_RESULT_")
-            raise CommandDenied(name, result, self._recent_text())
+            raise CommandDenied(name, result, self._texts_since(sent_at))
         tries = self.config.command_retries + 1
         raise CommandTimeout(f"{name}: no COMMAND_ACK after {tries} tries")
 
@@ -222,12 +257,26 @@ class MavlinkLink:
     def _spawn(self, coro: Any) -> asyncio.Task[Any]:
         task = asyncio.get_running_loop().create_task(coro)
         self._tasks.add(task)
-        task.add_done_callback(self._tasks.discard)
+        task.add_done_callback(self._reap)
         return task
+
+    def _reap(self, task: asyncio.Task[Any]) -> None:
+        """Forget a finished command; its error is retrieved here so that one
+        nobody awaits (a position target, a cancelled behaviour's command)
+        never becomes "Task exception was never retrieved"."""
+        self._tasks.discard(task)
+        if not task.cancelled() and task.exception() is not None:
+            log.debug("command ended: %s", task.exception())
 
     def _recent_text(self) -> str:
         text, stamp = self._last_text
         return text if self.clock() - stamp <= TEXT_FRESH_S else ""
+
+    def _texts_since(self, since: float) -> str:
+        """Every STATUSTEXT since ``since`` (ArduCopter sends one per failed
+        pre-arm check before the ACK), else the last one if fresh."""
+        texts = [text for text, stamp in self._texts if stamp >= since]
+        return "; ".join(dict.fromkeys(texts)) or self._recent_text()
 
     # -- receiving -------------------------------------------------------------------
 
@@ -258,6 +307,11 @@ class MavlinkLink:
         s = self._state
         match kind:
             case "GLOBAL_POSITION_INT":
+                self._last_position = self.clock()
+                no_fix = 0 <= s.gps_fix_type < 3
+                if (msg.lat == 0 and msg.lon == 0) or no_fix:  # no position yet: not 0 N 0 E
+                    self._state = dataclasses.replace(s, known=False)
+                    return
                 geo = GeoPoint(lat_deg=msg.lat / 1e7, lon_deg=msg.lon / 1e7, alt_m=msg.alt / 1000)
                 local = self.frame.to_local(geo)
                 position = Point(x_m=local.x_m, y_m=local.y_m, z_m=msg.relative_alt / 1000)
@@ -276,9 +330,23 @@ class MavlinkLink:
                 self._battery_status_seen = True
                 charging = msg.charge_state == mav.MAV_BATTERY_CHARGE_STATE_CHARGING
                 fraction = msg.battery_remaining / 100
-                self._state = dataclasses.replace(s, battery_fraction=fraction, charging=charging)
-            case "SYS_STATUS" if msg.battery_remaining >= 0 and not self._battery_status_seen:
-                self._state = dataclasses.replace(s, battery_fraction=msg.battery_remaining / 100)
+                self._state = dataclasses.replace(
+                    s, battery_fraction=fraction, charging=charging, battery_known=True
+                )
+            case "SYS_STATUS":
+                self._on_sys_status(msg)
+            case "GPS_RAW_INT":
+                self._state = dataclasses.replace(s, gps_fix_type=msg.fix_type)
+                if msg.fix_type < 3 and s.known:
+                    self._state = dataclasses.replace(self._state, known=False)
+            case "EKF_STATUS_REPORT":
+                self._state = dataclasses.replace(s, ekf_flags=msg.flags)
+            case "HOME_POSITION":
+                lat, lon = msg.latitude / 1e7, msg.longitude / 1e7
+                home = GeoPoint(lat_deg=lat, lon_deg=lon, alt_m=msg.altitude / 1000)
+                if home != s.home:
+                    log.info("autopilot home %s", home)
+                self._state = dataclasses.replace(s, home=home)
             case "COMMAND_ACK":
                 future = self._acks.get(msg.command)
                 final = msg.result != mav.MAV_RESULT_IN_PROGRESS
@@ -286,11 +354,28 @@ class MavlinkLink:
                     future.set_result(msg)
             case "STATUSTEXT":
                 self._last_text = (msg.text, self.clock())
+                self._texts.append(self._last_text)
+                if msg.text.startswith(ARM_TEXTS):
+                    self._state = dataclasses.replace(s, arm_text=msg.text)
                 if msg.text.startswith(GRIPPER_TEXT):
                     self._state = dataclasses.replace(s, gripper_text=msg.text)
                 elif msg.text.startswith(CRASH_TEXT):
                     self._crashed(msg.text)
                 log.info("autopilot: %s", msg.text)
+
+    def _on_sys_status(self, msg: Any) -> None:
+        s = self._state
+        changes: dict[str, Any] = {}
+        if msg.onboard_control_sensors_present & PREARM_BIT:
+            ok = bool(msg.onboard_control_sensors_health & PREARM_BIT)
+            changes["prearm_ok"] = ok
+            if ok:
+                changes["arm_text"] = ""
+        if msg.battery_remaining >= 0 and not self._battery_status_seen:
+            changes["battery_fraction"] = msg.battery_remaining / 100
+            changes["battery_known"] = True
+        if changes:
+            self._state = dataclasses.replace(s, **changes)
 
     def _on_heartbeat(self, msg: Any) -> None:
         if msg.type == mav.MAV_TYPE_GCS or msg.autopilot == mav.MAV_AUTOPILOT_INVALID:
@@ -308,6 +393,8 @@ class MavlinkLink:
         mode = COPTER_MODES.get(msg.custom_mode, str(msg.custom_mode))
         if not self._state.link_ok:
             log.info("autopilot heartbeat received")
+            if self._streams_task is None or self._streams_task.done():
+                self._request_streams()  # back after a loss: it may have rebooted
         s = self._state
         in_air = s.flight_state in (FlightState.FLYING, FlightState.TAKING_OFF)
         fell = s.armed and not armed and in_air and mode not in ("LAND", "RTL")
@@ -322,11 +409,18 @@ class MavlinkLink:
             self._state = dataclasses.replace(self._state, flight_state=FlightState.CRASHED)
 
     def _request_streams(self) -> None:
-        self._spawn(self._streams())
+        if self._streams_task is not None and not self._streams_task.done():
+            return
+        self._streams_asked = self.clock()
+        self._streams_task = self._spawn(self._streams())
 
     async def _streams(self) -> None:
-        """Ask for the telemetry we use (one at a time: the ACKs carry no
-        message id); a refusal only means the autopilot streams by default."""
+        """Ask for the telemetry we use: by stream group (older autopilots),
+        then per message (one at a time: the ACKs carry no message id); a
+        refusal only means the autopilot streams by default."""
+        system, component = await self._wait_target()
+        for stream, hz in DATA_STREAMS_HZ.items():
+            self._conn.mav.request_data_stream_send(system, component, stream, hz, 1)
         for name, hz in STREAMS_HZ.items():
             msg_id = getattr(mav, f"MAVLINK_MSG_ID_{name}")
             interval_us = 1e6 / hz
@@ -336,6 +430,14 @@ class MavlinkLink:
                 )
             except (CommandDenied, CommandTimeout) as exc:
                 log.debug("stream request refused: %s", exc)
+        try:  # home now, if set (ArduPilot also announces it when it changes)
+            await self._command(
+                "request home",
+                mav.MAV_CMD_REQUEST_MESSAGE,
+                mav.MAVLINK_MSG_ID_HOME_POSITION,
+            )
+        except (CommandDenied, CommandTimeout) as exc:
+            log.debug("home request refused: %s", exc)
 
     def _send_heartbeat(self) -> None:
         if self._conn is not None:

@@ -34,9 +34,22 @@ class Pending(Protocol):
     def cancel(self) -> bool: ...
 
 
+EKF_NEEDED = 0x1 | 0x2 | 0x10 | 0x20  # EKF_STATUS_REPORT: attitude, horiz velocity, abs position
+EKF_CONST_POS_MODE = 0x80  # no absolute position: the EKF holds a constant position
+
+
 @dataclasses.dataclass(frozen=True, kw_only=True)
 class VehicleState:
-    """The autopilot's latest report, in the site's local frame."""
+    """The autopilot's latest report, in the site's local frame.
+
+    Readiness (can it arm?) comes from what ArduCopter reports before arming:
+    GPS_RAW_INT's fix, EKF_STATUS_REPORT's flags, HOME_POSITION and the
+    pre-arm bit of SYS_STATUS. A report never received counts as no
+    objection (-1 / None), except home, position and battery, which must
+    have been seen. ``known`` is False while the autopilot has no position
+    (no 3-D fix, or lat = lon = 0, as ArduCopter sends before its EKF has an
+    origin); ``battery_known`` until the first battery report.
+    """
 
     position: Point = _ORIGIN
     geo: GeoPoint = _NOWHERE
@@ -48,8 +61,40 @@ class VehicleState:
     mode: str = ""
     flight_state: FlightState = FlightState.UNKNOWN
     link_ok: bool = False  # heartbeats arriving
-    known: bool = False  # a position has been received
+    known: bool = False  # a real position has been received (a fix, not lat = lon = 0)
     gripper_text: str = ""  # the autopilot's last "Gripper: ..." text since a gripper command
+    battery_known: bool = False  # a battery report has been received
+    gps_fix_type: int = -1  # GPS_RAW_INT fix_type (-1: never reported)
+    ekf_flags: int = -1  # EKF_STATUS_REPORT flags (-1: never reported)
+    home: GeoPoint | None = None  # HOME_POSITION (None: not set yet)
+    prearm_ok: bool | None = None  # SYS_STATUS pre-arm check bit (None: not reported)
+    arm_text: str = ""  # the autopilot's last "PreArm: ..." / "Arm: ..." text
+
+    @property
+    def not_ready_reason(self) -> str:
+        """Why the autopilot cannot arm now ("" when it can, as far as it says)."""
+        if not self.link_ok:
+            return "no autopilot heartbeat"
+        if 0 <= self.gps_fix_type < 3:
+            return "GPS: no 3-D fix"
+        if self.ekf_flags >= 0 and (
+            self.ekf_flags & EKF_NEEDED != EKF_NEEDED or self.ekf_flags & EKF_CONST_POS_MODE
+        ):
+            return "EKF: no absolute position"
+        if not self.known:
+            return "position unknown"
+        if self.home is None:
+            return "home not set"
+        if not self.battery_known:
+            return "battery unknown"
+        if self.prearm_ok is False:
+            return "pre-arm checks failing" + (f" ({self.arm_text})" if self.arm_text else "")
+        return ""
+
+    @property
+    def ready(self) -> bool:
+        """The autopilot reports nothing that stops it arming."""
+        return not self.not_ready_reason
 
     @property
     def landed(self) -> bool:

@@ -25,6 +25,10 @@ class AgentBehaviour(py_trees.behaviour.Behaviour):
     def __init__(self, name: str, ctx: Context) -> None:
         super().__init__(name)
         self.ctx = ctx
+        # set by a behaviour that fails, for the task guard: a short code, and
+        # whether the reason is passing (retry later or elsewhere)
+        self.failure_code = ""
+        self.retryable = False
 
 
 class Condition(AgentBehaviour):
@@ -48,9 +52,12 @@ class CommandSlot:
         self._pending: Pending | None = None
         self.label = ""
         self.error = ""
+        self.failed: BaseException | None = None  # the exception of the last failure
+        self.failed_label = ""  # what failed last
 
     def issue(self, label: str, pending: Pending) -> None:
         self.label, self._pending, self.error = label, pending, ""
+        self.failed, self.failed_label = None, ""
 
     def check(self) -> Status:
         """RUNNING while in flight; SUCCESS when acknowledged (or when none
@@ -62,10 +69,12 @@ class CommandSlot:
             return Status.RUNNING
         self._pending = None
         if pending.cancelled():
+            self.failed_label = self.label
             self.error, self.label = f"{self.label}: cancelled", ""
             return Status.FAILURE
         exc = pending.exception()
         if exc is not None:
+            self.failed, self.failed_label = exc, self.label
             self.error, self.label = str(exc), ""
             return Status.FAILURE
         return Status.SUCCESS

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from onboard_agent.autopilot.errors import CommandDenied, CommandTimeout
 from onboard_agent.autopilot.protocol import GUIDED
 from onboard_agent.behaviours.base import AgentBehaviour, CommandSlot, Status
 from onboard_agent.context import Context
@@ -16,10 +17,18 @@ class GoNear(AgentBehaviour):
     """SUCCESS once the target is reached; RUNNING while taking off and
     flying; FAILURE when the target is unknown or the autopilot refuses.
 
-    On the ground: GUIDED, arm, take off to ``takeoff_alt_m``, each command
-    acknowledged before the next. In the air: GUIDED if needed, then the
-    position target, re-sent every ``goto_resend_s`` and whenever the target
-    moved more than ``follow_threshold_m`` (a walking worker)."""
+    On the ground: wait until the autopilot reports it can arm (GPS fix, EKF,
+    home, pre-arm checks; at most ``ready_timeout_s``), then GUIDED, arm,
+    take off to ``takeoff_alt_m``, each command acknowledged before the next.
+    In the air: GUIDED if needed, then the position target, re-sent every
+    ``goto_resend_s`` and whenever the target moved more than
+    ``follow_threshold_m`` (a walking worker).
+
+    A refused or unanswered mode change, arm or takeoff is retried after a
+    backoff (``retry_backoff_s``, doubling up to ``retry_backoff_max_s``), up
+    to ``arm_attempts`` times, with the autopilot's reason as feedback; then,
+    like a readiness time-out, the behaviour fails *retryable* (the task may
+    succeed later or on another UAV)."""
 
     def __init__(self, target: Target, ctx: Context, name: str | None = None) -> None:
         super().__init__(name or f"Go near {target.label}", ctx)
@@ -29,11 +38,18 @@ class GoNear(AgentBehaviour):
         self._sent: Point | None = None
         self._sent_at = 0.0
         self._takeoff_at = 0.0
+        self._refusals = 0
+        self._retry_at = -1e18
+        self._refused = ""
+        self._waiting_since: float | None = None
 
     def initialise(self) -> None:
         self.command.cancel()
         self._done.clear()
         self._sent = None
+        self._refusals, self._retry_at, self._refused = 0, -1e18, ""
+        self._waiting_since = None
+        self.failure_code, self.retryable = "", False
 
     def update(self) -> Status:
         status = self.command.check()
@@ -41,8 +57,11 @@ class GoNear(AgentBehaviour):
             self.feedback_message = f"waiting for {self.command.label}"
             return status
         if status is Status.FAILURE:
-            self.feedback_message = self.command.error
-            return status
+            return self._refusal()
+        if self.ctx.clock() < self._retry_at:
+            wait = self._retry_at - self.ctx.clock()
+            self.feedback_message = f"{self._refused}; retrying in {wait:.0f} s"
+            return Status.RUNNING
         if self.command.label:
             self._done.add(self.command.label)
             self.command.label = ""
@@ -61,9 +80,44 @@ class GoNear(AgentBehaviour):
             return self._take_off()
         return self._fly(point)
 
+    def _refusal(self) -> Status:
+        """A command failed: transient reasons are retried after a backoff."""
+        exc, config = self.command.failed, self.ctx.config
+        self._refused = self.command.error
+        if not isinstance(exc, CommandDenied | CommandTimeout):
+            self.feedback_message = self.command.error
+            return Status.FAILURE
+        self._refusals += 1
+        code = "command_timeout" if isinstance(exc, CommandTimeout) else "arm_refused"
+        if self.command.failed_label in ("mode", "guided"):
+            code = "mode_refused" if code == "arm_refused" else code
+        elif self.command.failed_label == "takeoff" and code == "arm_refused":
+            code = "takeoff_refused"
+        if self._refusals >= config.arm_attempts:
+            self.feedback_message = f"{self.command.error} ({self._refusals} tries)"
+            self.failure_code, self.retryable = code, True
+            return Status.FAILURE
+        backoff = config.retry_backoff_s * 2 ** (self._refusals - 1)
+        self._retry_at = self.ctx.clock() + min(backoff, config.retry_backoff_max_s)
+        self.feedback_message = f"{self.command.error}; retrying in {backoff:.0f} s"
+        return Status.RUNNING
+
     def _take_off(self) -> Status:
         ctx, vehicle = self.ctx, self.ctx.vehicle
         autopilot = ctx.autopilot
+        if "takeoff" not in self._done and not vehicle.armed:
+            why = vehicle.not_ready_reason
+            if why:
+                now = ctx.clock()
+                if self._waiting_since is None:
+                    self._waiting_since = now
+                if now - self._waiting_since > ctx.config.ready_timeout_s:
+                    self.feedback_message = f"autopilot not ready: {why}"
+                    self.failure_code, self.retryable = "not_ready", True
+                    return Status.FAILURE
+                self.feedback_message = f"waiting for the autopilot: {why}"
+                return Status.RUNNING
+            self._waiting_since = None
         if "takeoff" in self._done:
             if ctx.clock() - self._takeoff_at > LIFTOFF_TIMEOUT_S:
                 self._done.clear()  # disarmed on the ground meanwhile: start over

@@ -11,7 +11,7 @@ import concurrent.futures
 import dataclasses
 
 from onboard_agent.autopilot import GUIDED, LAND, CommandDenied, VehicleState
-from proto.geo import Point
+from proto.geo import GeoPoint, Point
 from proto.telemetry import FlightState
 
 
@@ -39,6 +39,8 @@ class FakeAutopilot:
             flight_state=FlightState.LANDED,
             link_ok=True,
             known=True,
+            battery_known=True,
+            home=GeoPoint(),  # a ready autopilot: home set, nothing against arming
         )
         self.calls: list[tuple[str, object]] = []
         self.target: Point | None = None

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from onboard_agent import AgentConfig
 from proto.telemetry import OutcomeResult
-from tests.onboard_agent.helpers import Rig, inspect_task, plan, point
+from tests.onboard_agent.helpers import TICK_S, Rig, inspect_task, plan, point
 
 
 def test_visits_waypoints_in_order_and_reports_each():
@@ -49,13 +49,20 @@ def test_resumes_a_split_inspection_where_it_stopped():
     assert outcome.waypoints_done == [3, 4]
 
 
-def test_refused_takeoff_fails_the_task_with_the_reason():
-    rig = Rig(config=AgentConfig(task_attempts=2))
+def test_arm_refusals_are_retried_with_backoff_then_fail_retryable_with_the_reason():
+    rig = Rig()
     rig.autopilot.deny["arm"] = "PreArm: Battery 1 below minimum arming capacity"
     rig.agent.offer_plan(plan(inspect_task()))
-    rig.run_until(lambda: rig.mission.head is None, max_ticks=50)
+    rig.tick(25)  # 2.5 s: refused at 0 s and 1 s, the next try not before 3 s
+    assert rig.autopilot.names().count("arm") == 2
+    assert "capacity; retrying in" in rig.agent.root.tip().feedback_message
+    assert rig.outcomes() == []  # the task is not failed on the first refusals
+    ticks = rig.run_until(lambda: rig.mission.head is None, max_ticks=600)
+    assert (25 + ticks) * TICK_S >= 1 + 2 + 4 + 8 + 16  # the doubling backoff
+    assert rig.autopilot.names().count("arm") == AgentConfig().arm_attempts
     [outcome] = rig.outcomes()
     assert outcome.result is OutcomeResult.FAILED
+    assert outcome.retryable and outcome.reason_code == "arm_refused"
     assert "PreArm: Battery 1 below minimum arming capacity" in outcome.reason
     assert "Go near WP" in outcome.reason
 

@@ -90,7 +90,7 @@ def scenario(
 
 
 def world(**kw) -> World:
-    params = kw.pop("params", AutopilotParams(auto_disarm_s=None))
+    params = kw.pop("params", AutopilotParams(auto_disarm_s=None, warmup_s=0.0))
     return World(scenario(**kw), params=params)
 
 

@@ -16,13 +16,21 @@ mavlink = mavutil.mavlink
 class Client:
     """Connects like ``mavproxy --master udpout:127.0.0.1:PORT``: it speaks first."""
 
-    def __init__(self, port: int, target_system: int) -> None:
+    def __init__(self, port: int, target_system: int, *, streams_hz: float = 10.0) -> None:
         self.conn = mavutil.mavlink_connection(
             f"udpout:127.0.0.1:{port}", source_system=255, source_component=190
         )
         self.target = target_system
         self.texts: list[str] = []
         self.hello()
+        if streams_hz > 0:
+            self.request_streams(streams_hz)
+
+    def request_streams(self, hz: float) -> None:
+        """What MAVProxy does on connecting: every stream group at ``hz``."""
+        self.conn.mav.request_data_stream_send(
+            self.target, 1, mavlink.MAV_DATA_STREAM_ALL, round(hz), 1
+        )
 
     def hello(self) -> None:
         self.conn.mav.heartbeat_send(mavlink.MAV_TYPE_GCS, mavlink.MAV_AUTOPILOT_INVALID, 0, 0, 0)

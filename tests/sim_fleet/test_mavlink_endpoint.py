@@ -19,7 +19,10 @@ ACCEPTED = mavlink.MAV_RESULT_ACCEPTED
 @pytest.fixture
 def fleet():
     cfg = FleetConfig(
-        speedup=SPEEDUP, rate_hz=50.0, base_port=0, params=AutopilotParams(auto_disarm_s=30.0)
+        speedup=SPEEDUP,
+        rate_hz=50.0,
+        base_port=0,
+        params=AutopilotParams(auto_disarm_s=30.0, warmup_s=0.0),
     )
     runner = FleetThread(Fleet(small_world(2), cfg)).start()
     try:
@@ -234,3 +237,124 @@ def test_static_peer_gets_telemetry_without_speaking_first():
     finally:
         runner.stop()
         listener.close()
+
+
+@pytest.fixture
+def warming():
+    """One vehicle with a 40 s (simulated, 2 s of wall time) GPS/EKF warm-up."""
+    cfg = FleetConfig(
+        speedup=SPEEDUP, rate_hz=50.0, base_port=0, params=AutopilotParams(warmup_s=40.0)
+    )
+    runner = FleetThread(Fleet(small_world(1), cfg)).start()
+    c = Client(runner.fleet.ports["uav1"], target_system=1)
+    try:
+        yield runner, c
+    finally:
+        c.close()
+        runner.stop()
+
+
+def test_nothing_but_heartbeats_until_a_client_asks():
+    cfg = FleetConfig(speedup=SPEEDUP, rate_hz=50.0, base_port=0)
+    runner = FleetThread(Fleet(small_world(1), cfg)).start()
+    c = Client(runner.fleet.ports["uav1"], target_system=1, streams_hz=0)
+    try:
+        c.wait("HEARTBEAT")
+        assert c.conn.recv_match(type="GLOBAL_POSITION_INT", blocking=True, timeout=1.0) is None
+        ack = c.command(mavlink.MAV_CMD_SET_MESSAGE_INTERVAL, 33, 200_000)
+        assert ack.result == ACCEPTED
+        c.wait("GLOBAL_POSITION_INT")
+        assert c.conn.recv_match(type="GPS_RAW_INT", blocking=True, timeout=0.5) is None
+        c.request_streams(5.0)  # REQUEST_DATA_STREAM, every group
+        for kind in ("GPS_RAW_INT", "EKF_STATUS_REPORT", "SYS_STATUS", "BATTERY_STATUS"):
+            c.wait(kind)
+    finally:
+        c.close()
+        runner.stop()
+
+
+def test_warm_up_refuses_arming_with_arducopter_texts_then_arms_and_rehomes(warming):
+    runner, c = warming
+    world = runner.fleet.world
+    pos = c.wait("GLOBAL_POSITION_INT")
+    assert (pos.lat, pos.lon) == (0, 0)  # no position before the EKF has an origin
+    assert c.wait("GPS_RAW_INT").fix_type < 3
+    ekf = c.wait("EKF_STATUS_REPORT")
+    assert ekf.flags & mavlink.EKF_CONST_POS_MODE
+    status = c.wait("SYS_STATUS")
+    assert status.onboard_control_sensors_present & mavlink.MAV_SYS_STATUS_PREARM_CHECK
+    assert not status.onboard_control_sensors_health & mavlink.MAV_SYS_STATUS_PREARM_CHECK
+    assert c.set_mode(Mode.GUIDED).result == ACCEPTED  # disarmed: any mode, as ArduCopter
+    ack = c.command(mavlink.MAV_CMD_COMPONENT_ARM_DISARM, 1)
+    assert ack.result == mavlink.MAV_RESULT_FAILED
+    c.wait_text(lambda t: t == "PreArm: AHRS: waiting for home")
+    c.wait_text(lambda t: t == "PreArm: GPS 1: Bad fix")
+    assert c.command(mavlink.MAV_CMD_REQUEST_MESSAGE, 242).result == ACCEPTED
+    home = c.wait("HOME_POSITION", timeout_s=10.0)  # sent when set, at the end of the warm-up
+    assert home.latitude != 0 and runner.call(lambda: world.time_s) >= 40.0
+    c.wait("GPS_RAW_INT", lambda m: m.fix_type == 3 and m.satellites_visible > 0)
+    c.wait("EKF_STATUS_REPORT", lambda m: not m.flags & mavlink.EKF_CONST_POS_MODE)
+    c.wait(
+        "SYS_STATUS",
+        lambda m: m.onboard_control_sensors_health & mavlink.MAV_SYS_STATUS_PREARM_CHECK,
+    )
+    c.wait("GLOBAL_POSITION_INT", lambda m: m.lat != 0)
+    c.texts.clear()
+    assert c.command(mavlink.MAV_CMD_COMPONENT_ARM_DISARM, 1).result == ACCEPTED
+    rehomed = c.wait("HOME_POSITION")  # ArduCopter re-homes (and says so) on arming
+    assert (rehomed.latitude, rehomed.longitude) == (home.latitude, home.longitude)
+    assert runner.call(lambda: world.vehicle("uav1").home_version) == 2
+
+
+def test_parameters_list_read_set_and_grip_enable(fleet, client):
+    client.conn.mav.param_request_list_send(1, 1)
+    values = {}
+    while len(values) < 5:
+        m = client.wait("PARAM_VALUE")
+        values[m.param_id] = m
+    count = next(iter(values.values())).param_count
+    while len(values) < count:
+        m = client.wait("PARAM_VALUE")
+        values[m.param_id] = m
+    assert values["GRIP_ENABLE"].param_value == 1.0  # uav1 carries a gripper
+    assert values["RTL_ALT"].param_value == 1500.0
+    assert sorted(m.param_index for m in values.values()) == list(range(count))
+    client.conn.mav.param_request_read_send(1, 1, b"RTL_ALT", -1)
+    assert client.wait("PARAM_VALUE", lambda m: m.param_id == "RTL_ALT").param_value == 1500
+    client.conn.mav.param_set_send(1, 1, b"GRIP_ENABLE", 0, mavlink.MAV_PARAM_TYPE_INT8)
+    assert client.wait("PARAM_VALUE", lambda m: m.param_id == "GRIP_ENABLE").param_value == 0
+    ack = client.command(mavlink.MAV_CMD_DO_GRIPPER, 1, 1)
+    assert ack.result == mavlink.MAV_RESULT_FAILED  # ArduCopter: gripper not enabled
+    client.conn.mav.param_set_send(1, 1, b"GRIP_ENABLE", 1, mavlink.MAV_PARAM_TYPE_INT8)
+    client.wait("PARAM_VALUE", lambda m: m.param_id == "GRIP_ENABLE" and m.param_value == 1)
+    assert client.command(mavlink.MAV_CMD_DO_GRIPPER, 1, 1).result == ACCEPTED
+    client.conn.mav.param_set_send(1, 1, b"RTL_ALT", 2500, mavlink.MAV_PARAM_TYPE_INT32)
+    client.wait("PARAM_VALUE", lambda m: m.param_id == "RTL_ALT" and m.param_value == 2500)
+    assert fleet.call(lambda: fleet.fleet.world.vehicle("uav1").rtl_alt_m) == 25.0
+
+
+def test_reposition_brake_and_loiter(fleet, client):
+    world = fleet.fleet.world
+    client.set_mode(Mode.GUIDED)
+    client.command(mavlink.MAV_CMD_COMPONENT_ARM_DISARM, 1)
+    client.command(mavlink.MAV_CMD_NAV_TAKEOFF, 0, 0, 0, 0, 0, 0, 4)
+    client.wait("GLOBAL_POSITION_INT", lambda m: m.relative_alt > 3900, timeout_s=20)
+    assert client.set_mode(Mode.BRAKE).result == ACCEPTED
+    lat, lon, _ = fleet.call(lambda: world.geo.to_geodetic((-10.0, 16.0, 0.0)))
+    frame = mavlink.MAV_FRAME_GLOBAL_RELATIVE_ALT_INT
+    ack = client.command_int(
+        mavlink.MAV_CMD_DO_REPOSITION, frame, -1, 0, 0, 0, lat * 1e7, lon * 1e7, 6
+    )
+    assert ack.result == mavlink.MAV_RESULT_DENIED  # not GUIDED and no change-mode flag
+    ack = client.command_int(
+        mavlink.MAV_CMD_DO_REPOSITION, frame, -1, 1, 0, 0, lat * 1e7, lon * 1e7, 6
+    )
+    assert ack.result == ACCEPTED
+    client.wait("HEARTBEAT", lambda m: m.custom_mode == Mode.GUIDED)
+    client.wait("GLOBAL_POSITION_INT", lambda m: abs(m.relative_alt - 6000) < 50, timeout_s=30)
+    assert client.set_mode(Mode.LOITER).result == ACCEPTED
+    here = fleet.call(lambda: world.vehicle("uav1").position)
+    client.wait("HEARTBEAT", lambda m: m.custom_mode == Mode.LOITER)
+    client.goto_global(lat, lon, 10.0)  # ignored outside GUIDED
+    client.wait("HEARTBEAT")
+    assert fleet.call(lambda: world.vehicle("uav1").position) == pytest.approx(here, abs=0.5)

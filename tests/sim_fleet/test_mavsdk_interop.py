@@ -33,6 +33,10 @@ async def fly(port: int) -> dict:
         system = await gcs.first_autopilot(timeout_s=10.0)
         assert system is not None
         telemetry, action = TelemetryAsync(system), ActionAsync(system)
+        await telemetry.set_rate_position(5.0)  # streams only what is asked for, as ArduCopter
+        await telemetry.set_rate_battery(1.0)
+        await telemetry.set_rate_health(1.0)  # SYS_STATUS, EKF_STATUS_REPORT
+        await first(telemetry.subscribe_health(), lambda h: h.is_armable)  # warmed up
         seen["position"] = await first(telemetry.subscribe_position())
         seen["battery"] = await first(telemetry.subscribe_battery())
         await action.arm()

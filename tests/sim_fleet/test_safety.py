@@ -14,7 +14,7 @@ from sim_fleet import autopilot as ap
 from sim_fleet.modes import FlightState
 from sim_fleet.safety import SafetyMonitor
 from sim_fleet.truth import sim_state
-from sim_fleet.vehicle import Vehicle
+from sim_fleet.vehicle import AutopilotParams, Vehicle
 from tests.sim_fleet.helpers import QUAD, airborne, command, run_until, scenario, world
 
 
@@ -82,9 +82,12 @@ def test_landing_away_from_every_station_is_an_off_pad_landing():
     [violation] = w.violations
     assert violation.kind == "off_pad_landing" and violation.vehicle_id == "u1"
     assert violation.position == (30.0, 30.0, 0.0)
-    # back home (L1, a landing spot without recharge, counts as a pad)
+    # back to L1 (a landing spot without recharge, counts as a pad); not by RTL:
+    # arming re-homed the vehicle where it stands, as ArduCopter does
     airborne(w, v, 10.0)
-    command(w, v, ap.CMD_NAV_RETURN_TO_LAUNCH)
+    assert v.home == (30.0, 30.0, 0.0)
+    goto(w, v, (0.0, 50.0, 10.0))
+    command(w, v, ap.CMD_NAV_LAND)
     run_until(w, lambda: v.state is FlightState.LANDED)
     assert len(w.violations) == 1
 
@@ -129,7 +132,7 @@ def test_safety_distances_come_from_the_scenario():
     assert SafetyRules().people_clearance_m == proto.Safety().people_clearance_m
     assert SafetyRules().separation_m == proto.Safety().separation_m
     rules = SafetyRules(people_clearance_m=3.0, separation_m=5.0)
-    w = World(dataclasses.replace(sc, safety=rules))
+    w = World(dataclasses.replace(sc, safety=rules), params=AutopilotParams(warmup_s=0.0))
     u1, u2 = w.vehicle("u1"), w.vehicle("u2")
     airborne(w, u1, 10.0)
     airborne(w, u2, 10.0)

@@ -7,8 +7,29 @@ from sim_fleet.geo import GeoFrame
 from sim_fleet.scenario import GeoOrigin
 
 
-def test_default_rates_and_message_interval_changes():
+def test_only_the_heartbeat_streams_until_asked_like_arducopter_with_sr_rates_at_0():
     s = streams.StreamSchedule(streams.TelemetryRates())
+    assert s.due(0.0) == [streams.HEARTBEAT]
+    assert s.interval_us(streams.GLOBAL_POSITION_INT) == -1
+    assert s.set_interval(streams.GLOBAL_POSITION_INT, 0)  # "default rate": 5 Hz
+    assert s.interval_us(streams.GLOBAL_POSITION_INT) == 200_000
+
+
+def test_request_data_stream_switches_arducopter_stream_groups():
+    s = streams.StreamSchedule(streams.TelemetryRates())
+    assert s.request_data_stream(2, 2.0, True)  # EXTENDED_STATUS
+    assert {streams.SYS_STATUS, streams.GPS_RAW_INT} <= set(s.due(0.0))
+    assert s.interval_us(streams.GPS_RAW_INT) == 500_000
+    assert s.request_data_stream(0, 4.0, True)  # ALL
+    assert s.interval_us(streams.EKF_STATUS_REPORT) == 250_000
+    assert s.request_data_stream(12, 4.0, False)  # EXTRA3 off
+    assert s.interval_us(streams.EKF_STATUS_REPORT) == -1
+    assert s.interval_us(streams.GLOBAL_POSITION_INT) == 250_000
+    assert not s.request_data_stream(99, 1.0, True)
+
+
+def test_default_rates_and_message_interval_changes():
+    s = streams.StreamSchedule(streams.TelemetryRates(stream_by_default=True))
     assert s.interval_us(streams.HEARTBEAT) == 1_000_000
     sent = [streams.GLOBAL_POSITION_INT in s.due(t / 10) for t in range(0, 11)]
     assert sum(sent) == 6  # 5 Hz over 1 s, both ends included
@@ -21,7 +42,7 @@ def test_default_rates_and_message_interval_changes():
 
 
 def test_coarse_ticks_send_once_per_tick_without_bursts():
-    s = streams.StreamSchedule(streams.TelemetryRates(position_hz=50.0))
+    s = streams.StreamSchedule(streams.TelemetryRates(position_hz=50.0, stream_by_default=True))
     counts = [s.due(t * 1.0).count(streams.GLOBAL_POSITION_INT) for t in range(5)]
     assert counts == [1, 1, 1, 1, 1]
 

@@ -84,7 +84,7 @@ def test_failed_gripper_acknowledges_but_does_nothing():
 
 def test_grab_takes_only_from_the_nearest_station_even_when_it_is_empty():
     # small world: P-wrench at (1, 5, 3), P-allen_wrench 1 m east, W1 at (0, 10, 3)
-    w = World(small_world(1), params=AutopilotParams(auto_disarm_s=None))
+    w = World(small_world(1), params=AutopilotParams(auto_disarm_s=None, warmup_s=0.0))
     v = w.vehicle("uav1")
     airborne(w, v, 4.5)
     goto(w, v, (1.2, 5.0, 4.5))

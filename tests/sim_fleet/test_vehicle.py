@@ -79,7 +79,7 @@ def test_rtl_climbs_returns_home_and_lands():
 
 
 def test_auto_disarm_after_delay_on_ground():
-    w = world(params=AutopilotParams(auto_disarm_s=10.0))
+    w = world(params=AutopilotParams(auto_disarm_s=10.0, warmup_s=0.0))
     v = w.vehicle("u1")
     command(w, v, 176, 1, Mode.GUIDED)
     command(w, v, 400, 1)

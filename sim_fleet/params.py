@@ -1,0 +1,63 @@
+"""A sensible subset of ArduCopter's parameters, for the MAVLink parameter protocol.
+
+Names, units and types are ArduCopter's (``RTL_ALT`` in cm, ``WPNAV_SPEED``
+in cm/s, ...). Values are floats on the wire, as ArduPilot sends them (cast,
+not byte-wise). Writes of a few take effect at once (see ``autopilot.set_param``);
+on a real ArduCopter ``GRIP_ENABLE`` needs a reboot, here it does not.
+Unknown names are ignored, as ArduPilot ignores them.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+# MAV_PARAM_TYPE
+INT8 = 2
+INT16 = 4
+INT32 = 6
+REAL32 = 9
+
+
+@dataclass(slots=True)
+class Param:
+    name: str
+    value: float
+    type: int = REAL32
+    read_only: bool = False
+
+
+class ParamStore:
+    """Ordered parameters of one vehicle (the order gives ``param_index``)."""
+
+    def __init__(self, params: list[Param]) -> None:
+        self._params = {p.name: p for p in params}
+        self._order = [p.name for p in params]
+
+    def __len__(self) -> int:
+        return len(self._order)
+
+    def __contains__(self, name: str) -> bool:
+        return name in self._params
+
+    def get(self, name: str) -> float:
+        return self._params[name].value
+
+    def param(self, name: str) -> Param | None:
+        return self._params.get(name)
+
+    def index_of(self, name: str) -> int:
+        return self._order.index(name)
+
+    def by_index(self, index: int) -> Param | None:
+        return self._params[self._order[index]] if 0 <= index < len(self._order) else None
+
+    def all(self) -> list[Param]:
+        return [self._params[n] for n in self._order]
+
+    def store(self, name: str, value: float) -> Param | None:
+        """Write ``value`` (rounded for integer types); None if unknown or read-only."""
+        p = self._params.get(name)
+        if p is None or p.read_only:
+            return None
+        p.value = float(round(value)) if p.type != REAL32 else float(value)
+        return p

@@ -1,0 +1,177 @@
+"""Readiness against a simulator that warms up like ArduCopter (GPS fix, EKF
+origin, home; lat = lon = 0 before), streams only what is asked for and
+refuses to arm with its pre-arm texts until then."""
+
+from __future__ import annotations
+
+import asyncio
+import time
+
+import pytest
+
+from onboard_agent import Agent, AgentConfig, CommandDenied
+from onboard_agent.autopilot.link import MavlinkLink
+from proto.geo import LocalFrame
+from proto.telemetry import AgentState, FlightState
+from sim_fleet import Fleet, FleetConfig, FleetThread
+from sim_fleet.from_proto import scenario_from_proto
+from sim_fleet.vehicle import AutopilotParams
+from tests.onboard_agent.conftest import SPEEDUP, fast_scenario
+from tests.onboard_agent.helpers import inspect_task, plan
+from tests.onboard_agent.test_link import until
+
+SCENARIO = fast_scenario()
+SITE = SCENARIO.site
+WARMUP_S = 50.0  # simulated: 5 s of wall time at x10
+CONFIG = AgentConfig(command_ack_timeout_s=0.3, command_retries=1, heartbeat_timeout_s=1.0)
+
+
+@pytest.fixture
+def warming():
+    """The paper's fleet, warming up for WARMUP_S simulated seconds."""
+    config = FleetConfig(
+        speedup=SPEEDUP,
+        rate_hz=50.0,
+        base_port=0,
+        params=AutopilotParams(auto_disarm_s=30.0, warmup_s=WARMUP_S),
+    )
+    runner = FleetThread(Fleet(scenario_from_proto(SITE, SCENARIO.fleet), config)).start()
+    try:
+        yield runner
+    finally:
+        runner.stop()
+
+
+def url(fleet, uav_id: str = "uav-1") -> str:
+    return f"udpout:127.0.0.1:{fleet.fleet.ports[uav_id]}"
+
+
+def sim_time(fleet) -> float:
+    return fleet.call(lambda: fleet.fleet.world.time_s)
+
+
+def test_link_reports_position_and_battery_unknown_and_not_ready_until_warmed_up(warming):
+    c1 = SITE.station("C1").position
+
+    async def main() -> dict:
+        link = MavlinkLink(url(warming), LocalFrame(SITE.origin), CONFIG)
+        link.start()
+        heartbeat = asyncio.create_task(link.run())
+        seen: dict = {}
+        try:
+            await until(lambda: link.state.link_ok, what="heartbeat")
+            seen["battery_at_start"] = (link.state.battery_known, link.state.battery_fraction)
+            await until(lambda: link.state.gps_fix_type >= 0, what="GPS_RAW_INT")
+            await until(lambda: link.state.battery_known, what="battery")
+            seen["early"] = link.state
+            seen["early_sim_s"] = sim_time(warming)
+            with pytest.raises(CommandDenied) as refused:
+                await link.arm()
+            seen["refused"] = refused.value
+            await until(lambda: link.state.ready, 20.0, "ready")
+            seen["ready"] = link.state
+            seen["ready_sim_s"] = sim_time(warming)
+            await link.set_mode("GUIDED")
+            await link.arm()
+            await until(lambda: link.state.armed, what="armed")
+        finally:
+            heartbeat.cancel()
+            link.close()
+        return seen
+
+    seen = asyncio.run(main())
+    assert seen["battery_at_start"] == (False, 0.0)  # unknown, not "0 %"
+    early = seen["early"]
+    assert seen["early_sim_s"] < WARMUP_S
+    assert not early.known  # lat = lon = 0 is no position
+    assert early.battery_fraction == 1.0
+    assert early.home is None and early.prearm_ok is False
+    assert early.not_ready_reason in ("GPS: no 3-D fix", "EKF: no absolute position")
+    assert "PreArm: AHRS: waiting for home" in str(seen["refused"])  # ArduCopter's reason
+    ready = seen["ready"]
+    assert seen["ready_sim_s"] >= WARMUP_S
+    assert ready.known and ready.position.distance_to(c1) < 0.1
+    assert ready.home is not None and ready.gps_fix_type == 3 and ready.prearm_ok
+
+
+def test_agent_is_not_ready_not_failed_no_false_emergency_and_flies_once_warmed_up(warming):
+    """The by-hand SITL flight: a plan arrives while the autopilot warms up.
+    The agent reports not ready (not failed), raises no energy emergency for
+    a position it does not have, does not try to arm before it can, and then
+    flies the task."""
+    config = AgentConfig(
+        command_ack_timeout_s=0.3,
+        command_retries=1,
+        heartbeat_timeout_s=1.0,
+        not_ready_state=True,
+    )
+
+    async def main() -> dict:
+        link = MavlinkLink(url(warming), LocalFrame(SITE.origin), config)
+        agent = Agent(
+            "uav-1",
+            SCENARIO,
+            link,
+            config,
+            clock=lambda: time.monotonic() * SPEEDUP,
+            wall=lambda: time.time() * SPEEDUP,
+        )
+        agent.ground_station("gs", True)
+        link.start()
+        heartbeat = asyncio.create_task(link.run())
+        seen: dict = {"states": set(), "emergencies": set()}
+        try:
+            await until(lambda: link.state.link_ok, what="heartbeat")
+            agent.offer_plan(plan(inspect_task(n=1, service_s=1.0)))
+            deadline = time.monotonic() + 30.0
+            while time.monotonic() < deadline:
+                agent.tick()
+                status = agent.status()
+                seen["states"].add(status.state)
+                if agent.ctx.emergency:
+                    seen["emergencies"].add(agent.ctx.emergency)
+                if status.state is AgentState.NOT_READY:
+                    seen["not_ready"] = status
+                if link.state.flight_state is FlightState.FLYING:
+                    seen["flying_sim_s"] = sim_time(warming)
+                    break
+                await asyncio.sleep(0.05)
+            seen["outcomes"] = agent.mission.take_outcomes()
+            seen["texts"] = link._last_text
+        finally:
+            heartbeat.cancel()
+            link.close()
+        return seen
+
+    seen = asyncio.run(main())
+    assert seen["emergencies"] == set()  # no "energy too low" from a 0 N 0 E position
+    assert AgentState.FAILED not in seen["states"] and AgentState.NOT_READY in seen["states"]
+    not_ready = seen["not_ready"]
+    assert not not_ready.ready and not_ready.reason.startswith("not ready: ")
+    assert not_ready.task_id == "t1" and not_ready.queue_length == 1
+    assert seen["outcomes"] == []  # the task was held, not failed
+    assert seen["flying_sim_s"] >= WARMUP_S
+    assert not seen["texts"][0].startswith("PreArm:")  # it never tried to arm too early
+
+
+def test_not_ready_is_reported_as_idle_or_busy_with_ready_false_by_default(warming):
+    async def main():
+        link = MavlinkLink(url(warming), LocalFrame(SITE.origin), CONFIG)
+        agent = Agent("uav-1", SCENARIO, link, CONFIG)
+        link.start()
+        heartbeat = asyncio.create_task(link.run())
+        try:
+            await until(lambda: link.state.link_ok and link.state.gps_fix_type >= 0)
+            idle = agent.status()
+            agent.offer_plan(plan(inspect_task()))
+            agent.tick()
+            busy = agent.status()
+        finally:
+            heartbeat.cancel()
+            link.close()
+        return idle, busy
+
+    idle, busy = asyncio.run(main())
+    assert (idle.state, idle.ready) == (AgentState.IDLE, False)
+    assert (busy.state, busy.ready) == (AgentState.BUSY, False)
+    assert busy.reason.startswith("not ready: ")
