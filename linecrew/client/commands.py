@@ -1,5 +1,6 @@
 """The operator commands of ``linecrew``: submit, gesture, actions, cancel,
-status, plan, events, fault. All go through the gateway over HTTP; ``--json``
+status, plan, events, fault. All go through the gateway over HTTP (which one:
+:mod:`linecrew.client.session`); ``--json``, anywhere on the command line,
 prints the raw answer instead of a table."""
 
 from __future__ import annotations
@@ -15,23 +16,66 @@ from typing import Any
 import msgspec
 from rich.console import Console
 
-from linecrew.client.gateway import Gateway, GatewayError, session
-from linecrew.client.render import actions_table, fleet_table, plan_timeline
+from linecrew.client.gateway import Gateway, GatewayError
+from linecrew.client.render import actions_table, fleet_table, plan_tasks, plan_timeline
+from linecrew.client.session import NoRunError, Target, resolve
 from linecrew.fault_kinds import add_fault_arguments, fault_from_args
+
+GLOBAL_VALUED = ("--url", "--token")
+"""Options of every operator command that take a value (hoisted like ``--json``)."""
 
 
 def _parser(prog: str, description: str) -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(prog=f"linecrew {prog}", description=description)
-    parser.add_argument("--url", help="gateway URL (else LINECREW_URL or the session file)")
+    parser.add_argument(
+        "--url", help="gateway URL (else LINECREW_URL, else the live run of the session file)"
+    )
     parser.add_argument("--token", help="bearer token (else LINECREW_TOKEN or the session file)")
-    parser.add_argument("--json", action="store_true", help="print JSON")
+    parser.add_argument("--json", action="store_true", help="print JSON (anywhere on the line)")
     return parser
 
 
-def _run(args: argparse.Namespace, work: Callable[[Gateway], Any], show: Callable[[Any], Any]):
-    url, token = session(args.url, args.token)
+def hoist_globals(argv: list[str]) -> list[str]:
+    """Move ``--json``, ``--url X`` and ``--token X`` to the front, wherever
+    they are (before a ``--``), so that they work after a sub-command too."""
+    front: list[str] = []
+    rest: list[str] = []
+    i = 0
+    while i < len(argv):
+        arg = argv[i]
+        if arg == "--":
+            rest += argv[i:]
+            break
+        if arg == "--json" or arg.startswith(tuple(f"{o}=" for o in GLOBAL_VALUED)):
+            front.append(arg)
+        elif arg in GLOBAL_VALUED and i + 1 < len(argv):
+            front += [arg, argv[i + 1]]
+            i += 1
+        else:
+            rest.append(arg)
+        i += 1
+    return front + rest
+
+
+def _parse(parser: argparse.ArgumentParser, argv: list[str]) -> argparse.Namespace:
+    return parser.parse_args(hoist_globals(argv))
+
+
+def _target(args: argparse.Namespace) -> Target | None:
+    """The gateway to talk to, or None after a one-line error on stderr."""
     try:
-        result = work(Gateway(url, token))
+        return resolve(args.url, args.token)
+    except NoRunError as exc:
+        print(f"linecrew: {exc}", file=sys.stderr)
+        return None
+
+
+def _run(args: argparse.Namespace, work: Callable[[Gateway], Any], show: Callable[[Any], Any]):
+    target = _target(args)
+    if target is None:
+        return 1
+    try:
+        result = work(Gateway(target.url, target.token))
     except GatewayError as exc:
         print(f"linecrew: {exc}", file=sys.stderr)
         return 1
@@ -86,7 +130,7 @@ def submit_main(argv: list[str]) -> int:
     deliver.add_argument("tool")
     deliver.add_argument("--from", dest="station", required=True, help="tool station id")
     deliver.add_argument("--to", dest="worker", required=True, help="worker id")
-    args = parser.parse_args(_negative_points(argv))
+    args = parser.parse_args(_negative_points(hoist_globals(argv)))
     body: dict[str, Any] = {"type": args.kind, "priority": args.priority}
     match args.kind:
         case "inspect":
@@ -112,7 +156,7 @@ def gesture_main(argv: list[str]) -> int:
     parser = _parser("gesture", "submit a crew gesture (e.g. bring-wrench W1)")
     parser.add_argument("gesture")
     parser.add_argument("target", help="tower, line or worker id")
-    args = parser.parse_args(argv)
+    args = _parse(parser, argv)
     body = {"gesture": args.gesture, "target": args.target}
     return _run(
         args, lambda g: g.call("POST", "/v1/gestures", json=body), lambda r: actions_table([r])
@@ -123,7 +167,7 @@ def actions_main(argv: list[str]) -> int:
     """``linecrew actions [--state S,...]``"""
     parser = _parser("actions", "list actions")
     parser.add_argument("--state", help="comma-separated states")
-    args = parser.parse_args(argv)
+    args = _parse(parser, argv)
     params = {"state": args.state} if args.state else {}
     return _run(args, lambda g: g.call("GET", "/v1/actions", params=params), actions_table)
 
@@ -132,7 +176,7 @@ def cancel_main(argv: list[str]) -> int:
     """``linecrew cancel ACTION_ID``"""
     parser = _parser("cancel", "cancel an action")
     parser.add_argument("action_id")
-    args = parser.parse_args(argv)
+    args = _parse(parser, argv)
     return _run(
         args,
         lambda g: g.call("DELETE", f"/v1/actions/{args.action_id}"),
@@ -142,32 +186,79 @@ def cancel_main(argv: list[str]) -> int:
 
 def status_main(argv: list[str]) -> int:
     """``linecrew status``: the fleet."""
-    args = _parser("status", "fleet table").parse_args(argv)
+    args = _parse(_parser("status", "fleet table"), argv)
     return _run(args, lambda g: g.call("GET", "/v1/fleet"), fleet_table)
 
 
 def plan_main(argv: list[str]) -> int:
-    """``linecrew plan``: the live plan as a timeline. With a problem file
-    (``linecrew plan PROBLEM ...``) it runs the offline planner instead."""
+    """``linecrew plan``: the live plan as a timeline and a table of task
+    times. With a file (``linecrew plan FILE ...``: a planning problem or a
+    scenario) it runs the offline planner instead."""
     if (argv and not argv[0].startswith("-")) or "--validate" in argv:
-        from ground_station.planner.cli import plan_main as offline
+        from linecrew.client.offline_plan import main as offline
 
         return offline(argv)
-    parser = _parser("plan", "live plan of every UAV (give a PROBLEM file to plan offline)")
-    parser.add_argument("--speedup", type=float, default=1.0, help="the run's mission speed-up")
-    args = parser.parse_args(argv)
-    now = time.time() * args.speedup
-    return _run(args, lambda g: g.call("GET", "/v1/plan"), lambda p: plan_timeline(p, now))
+    parser = _parser(
+        "plan",
+        "the live plan of every UAV, times in mission seconds from now "
+        "(or: linecrew plan FILE, FILE a planning problem or a scenario, to plan offline)",
+    )
+    parser.epilog = (
+        "offline: linecrew plan FILE [-o PLAN.json] [--improve-ms N] [--mode complete|paper]; "
+        "FILE is a planning problem (example: ground_station/planner/examples/paper.yaml) or a "
+        "scenario (example: linecrew/scenarios/paper.yaml); "
+        "linecrew plan --validate PROBLEM PLAN checks a plan."
+    )
+    parser.add_argument(
+        "--speedup",
+        type=float,
+        help="the run's mission speed-up (default: the session file's, else the fleet's clock)",
+    )
+    args = _parse(parser, argv)
+    target = _target(args)
+    if target is None:
+        return 1
+    gateway = Gateway(target.url, target.token)
+    try:
+        plans = gateway.call("GET", "/v1/plan")
+        fleet = [] if args.json else gateway.call("GET", "/v1/fleet")
+    except GatewayError as exc:
+        print(f"linecrew: {exc}", file=sys.stderr)
+        return 1
+    if args.json:
+        print(json.dumps(plans, indent=2))
+        return 0
+    speedup = args.speedup or (target.run.speedup if target.run else None)
+    now, clock = mission_now(fleet, speedup)
+    console = Console()
+    console.print(plan_timeline(plans, now, clock))
+    console.print(plan_tasks(plans, now))
+    return 0
+
+
+def mission_now(fleet: list[dict[str, Any]], speedup: float | None) -> tuple[float, str]:
+    """The run's mission clock now, and how it was found: from a known
+    speed-up (mission s = UNIX s x K), else from the freshest telemetry
+    stamp (mission seconds, at most a telemetry period old), else UNIX time."""
+    if speedup:
+        return time.time() * speedup, f"x{speedup:g}"
+    stamps = [u["telemetry"]["stamp_s"] for u in fleet if u.get("telemetry")]
+    if stamps:
+        now = max(stamps)
+        return now, f"x{now / time.time():.3g} from telemetry"
+    return time.time(), "x1 (no telemetry; give --speedup)"
 
 
 def events_main(argv: list[str]) -> int:
     """``linecrew events [--after SEQ]``: follow the event stream."""
     parser = _parser("events", "follow ground-station events (Ctrl-C to stop)")
     parser.add_argument("--after", type=int, help="replay events after this sequence number")
-    args = parser.parse_args(argv)
-    url, token = session(args.url, args.token)
+    args = _parse(parser, argv)
+    target = _target(args)
+    if target is None:
+        return 1
     try:
-        for event in Gateway(url, token).events(args.after):
+        for event in Gateway(target.url, target.token).events(args.after):
             if args.json:
                 print(json.dumps(event), flush=True)
             else:
@@ -187,7 +278,7 @@ def fault_main(argv: list[str]) -> int:
     """``linecrew fault KIND TARGET [VALUES]`` through the gateway (simulation only)."""
     parser = _parser("fault", "inject a simulator fault through the gateway")
     add_fault_arguments(parser)
-    args = parser.parse_args(argv)
+    args = _parse(parser, argv)
     try:
         fault = msgspec.to_builtins(fault_from_args(args))
     except ValueError as exc:

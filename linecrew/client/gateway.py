@@ -1,24 +1,15 @@
-"""HTTP access to a linecrew gateway for the operator CLI.
-
-Where to find it: ``--url`` / ``--token``, else ``LINECREW_URL`` /
-``LINECREW_TOKEN``, else the session file that ``linecrew up`` writes
-(``.linecrew/session.json`` in the current directory).
-"""
+"""HTTP access to a linecrew gateway for the operator CLI (which gateway:
+:mod:`linecrew.client.session`)."""
 
 from __future__ import annotations
 
 import json
-import os
-import pathlib
 from collections.abc import Iterator
 from typing import Any
 
 import httpx
 
 from proto.errors import LinecrewError
-
-SESSION_FILE = pathlib.Path(".linecrew") / "session.json"
-DEFAULT_URL = "http://127.0.0.1:8080"
 
 
 class GatewayError(LinecrewError):
@@ -31,24 +22,6 @@ class GatewayError(LinecrewError):
         super().__init__(message)
         self.status = status  # the HTTP status, when the gateway answered
         self.body = body  # the decoded JSON error ({"error", "message", "field"}), if any
-
-
-def session(url: str | None, token: str | None) -> tuple[str, str]:
-    """The gateway URL and token to use."""
-    saved: dict[str, str] = {}
-    if SESSION_FILE.is_file():
-        saved = json.loads(SESSION_FILE.read_text())
-    url = url or os.environ.get("LINECREW_URL") or saved.get("url") or DEFAULT_URL
-    token = token or os.environ.get("LINECREW_TOKEN") or saved.get("token") or ""
-    return url, token
-
-
-def write_session(url: str, token: str) -> pathlib.Path:
-    """Remember a running gateway for later CLI calls (``linecrew up`` does this)."""
-    SESSION_FILE.parent.mkdir(exist_ok=True)
-    SESSION_FILE.write_text(json.dumps({"url": url, "token": token}))
-    SESSION_FILE.chmod(0o600)
-    return SESSION_FILE
 
 
 class Gateway:

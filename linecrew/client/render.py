@@ -80,11 +80,41 @@ def timeline(
     return table
 
 
-def plan_timeline(plans: list[dict[str, Any]], now_s: float) -> Table:
-    """The planned tasks of every UAV from ``now_s`` on."""
+def plan_timeline(plans: list[dict[str, Any]], now_s: float, clock: str = "") -> Table:
+    """The planned tasks of every UAV from ``now_s`` (mission seconds) on."""
     rows = [
         (p["uav_id"], f"e{p['epoch']}", [(t["start_s"], t["end_s"], t["type"]) for t in p["tasks"]])
         for p in plans
     ]
     end = max((t["end_s"] for p in plans for t in p["tasks"]), default=now_s + 1.0)
-    return timeline(rows, now_s, end, "Plan")
+    title = f"Plan from now{f' ({clock})' if clock else ''}"
+    return timeline(rows, now_s, max(end, now_s + 1.0), title)
+
+
+def _relative(seconds: float) -> str:
+    return f"{seconds:+.0f} s"
+
+
+def plan_tasks(plans: list[dict[str, Any]], now_s: float) -> Table:
+    """Every planned task with its start and end in mission seconds from
+    ``now_s`` (negative: already begun or over)."""
+    table = Table(title="Planned tasks (mission seconds from now)")
+    for column in ("UAV", "epoch", "task", "kind", "action"):
+        table.add_column(column, no_wrap=True)
+    for column in ("start", "end", "lasts"):
+        table.add_column(column, justify="right", no_wrap=True)
+    for plan in plans:
+        for task in plan["tasks"]:
+            table.add_row(
+                plan["uav_id"],
+                str(plan["epoch"]),
+                task["task_id"],
+                task["type"],
+                task.get("action_id") or "-",
+                _relative(task["start_s"] - now_s),
+                _relative(task["end_s"] - now_s),
+                f"{task['end_s'] - task['start_s']:.0f} s",
+            )
+    if not table.rows:
+        table.caption = "no UAV has a planned task"
+    return table

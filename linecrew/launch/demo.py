@@ -3,13 +3,15 @@
 Starts everything (as ``linecrew up``), says what runs and what the scenario
 asks, submits the scripted actions at their times through the REST gateway,
 tells the ground station's events in plain words above a live progress bar
-per action, and ends with the executed timeline and a summary. Exit code 0
+per action, and ends with the executed timeline, a summary and the run
+report (``RUN_DIR/report.html``, see :mod:`linecrew.report`). Exit code 0
 only if every action completed.
 """
 
 from __future__ import annotations
 
 import argparse
+import pathlib
 import sys
 import time
 from collections.abc import Callable
@@ -34,6 +36,15 @@ from proto import GetSimState, GsEvent, SimState
 from proto.scenario import Scenario
 
 TERMINAL = {"completed", "failed", "cancelled"}
+HELP = """\
+The paper's scenario (or --scenario FILE) end to end: starts everything as
+linecrew up does, says what runs and what the scenario asks, submits the
+scripted actions at their times through the REST gateway, tells the ground
+station's events in plain words above a progress bar per action, and ends
+with the executed timeline, a summary and the run report (an HTML page in
+the run directory, its path printed last). Exit code 0 only if every action
+completed.
+"""
 
 
 def run_mission(
@@ -127,7 +138,7 @@ def main(argv: list[str] | None = None) -> int:
     """Run the demo; 0 only if every action completed."""
     parser = argparse.ArgumentParser(
         prog="linecrew demo",
-        description=__doc__,
+        description=HELP,
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     add_run_arguments(parser)
@@ -163,4 +174,19 @@ def main(argv: list[str] | None = None) -> int:
     console.print(
         "[green]every action completed[/]" if ok else "[red]not every action completed[/]"
     )
+    report_of(run.run_dir, console)
     return 0 if ok else 1
+
+
+def report_of(run_dir: pathlib.Path, console: Console) -> pathlib.Path | None:
+    """Write the run's report and print its path (a failure is reported, not raised:
+    the mission's outcome stands)."""
+    from linecrew.report import write_report
+
+    try:
+        path = write_report(run_dir)
+    except Exception as exc:  # the report is extra: never mask the mission's result
+        print(f"linecrew demo: no report: {exc}", file=sys.stderr)
+        return None
+    console.print(f"report: {path}", markup=False, highlight=False)
+    return path

@@ -1,22 +1,31 @@
 """Everything of a linecrew deployment on this machine, as child processes:
 router, ground station, gateway, simulator and one agent per UAV, on
 loopback with free ports, started in dependency order and checked healthy.
-Used by ``linecrew up`` and ``linecrew demo``."""
+Used by ``linecrew up`` and ``linecrew demo``.
+
+The run directory gets the scenario (``scenario.json``), what the run is
+(``run.json``: speed-up, gateway, start), one log per process, the ground
+station's store (``gs.db``) and what the UAVs reported (``flight.jsonl``,
+see :mod:`linecrew.launch.flight_log`). While it runs, its gateway is
+registered in the session file (:mod:`linecrew.client.session`)."""
 
 from __future__ import annotations
 
 import dataclasses
 import datetime
+import json
 import logging
 import pathlib
+import time
 
 import httpx
 import msgspec
 
 from linecrew.bus import Bus, BusConfig
 from linecrew.bus.router_process import free_port, port_open
-from linecrew.client.gateway import write_session
+from linecrew.client import session
 from linecrew.launch import secure
+from linecrew.launch.flight_log import FlightLog
 from linecrew.launch.ports import free_udp_block
 from linecrew.launch.supervisor import Supervisor
 from proto.keys import KeySpace, Role
@@ -35,6 +44,8 @@ class RunOptions:
     lease_ms: int = 500  # zenoh lease of every process
     start_timeout_s: float = 60.0  # per process
     secure: bool = False  # mutual TLS and access control (``secure``)
+    session_file: pathlib.Path | None = None  # default: $LINECREW_SESSION or .linecrew/
+    register: bool = True  # list the run in the session file while it is up
 
 
 class LocalRun:
@@ -51,6 +62,8 @@ class LocalRun:
         self.url = ""
         self.token = ""
         self.bus: Bus | None = None
+        self.flight_log: FlightLog | None = None
+        self.session_file: pathlib.Path | None = None  # where the run is registered
 
     def __enter__(self) -> LocalRun:
         try:
@@ -65,6 +78,12 @@ class LocalRun:
 
     def close(self) -> None:
         """Stop every process (newest first) and leave the bus."""
+        if self.session_file is not None:
+            session.unregister(self.url, self.session_file)
+            self.session_file = None
+        if self.flight_log is not None:
+            self.flight_log.close()
+            self.flight_log = None
         if self.bus is not None:
             self.bus.close()
             self.bus = None
@@ -75,6 +94,7 @@ class LocalRun:
         self.run_dir.mkdir(parents=True, exist_ok=True)
         scenario_file = self.run_dir / "scenario.json"
         scenario_file.write_bytes(msgspec.json.encode(self.scenario))
+        started_s = time.time()
         uavs = [u.id for u in self.scenario.fleet.uavs]
         router_port = free_port()
         profile = secure.prepare(self.run_dir / "tls", uavs) if opts.secure else None
@@ -113,6 +133,7 @@ class LocalRun:
                 config_file=profile.client_config("operator") if profile else None,
             )
         )
+        self.flight_log = FlightLog(self.bus, keys, self.run_dir / "flight.jsonl")
 
         gs = sup.start(
             "ground-station",
@@ -153,7 +174,12 @@ class LocalRun:
         )
         sup.wait_ready(gateway, self._gateway_healthy, wait)
         self.token = token_file.read_text().strip()
-        write_session(self.url, self.token)
+        self._describe(started_s)
+        if opts.register:
+            entry = session.entry_for(
+                self.url, self.token, self.run_dir, opts.speedup, self.scenario.name
+            )
+            self.session_file = session.register(entry, opts.session_file)
 
         for index, uav_id in enumerate(uavs):
             agent = sup.start(
@@ -169,6 +195,19 @@ class LocalRun:
             )
             sup.wait_ready(agent, lambda u=uav_id: self._alive(Role.AGENT, u), wait)
         log.info("all processes healthy", extra={"run_dir": str(self.run_dir)})
+
+    def _describe(self, started_s: float) -> None:
+        """``run.json``: what ``linecrew report`` needs to know of the run."""
+        about = {
+            "scenario": self.scenario.name,
+            "site": self.keys.site,
+            "speedup": self.options.speedup,
+            "started_s": started_s,  # UNIX seconds
+            "started_mission_s": started_s * self.options.speedup,
+            "gateway": self.url,
+            "uavs": [u.id for u in self.scenario.fleet.uavs],
+        }
+        (self.run_dir / "run.json").write_text(json.dumps(about, indent=1))
 
     def _alive(self, role: Role, ident: str) -> bool:
         assert self.bus is not None

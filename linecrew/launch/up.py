@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import argparse
 import pathlib
+import shlex
 import sys
 
 from linecrew.launch.local_run import LocalRun, RunOptions
@@ -20,6 +21,15 @@ from linecrew.scenarios import ScenarioError, builtin_names, load, with_fleet_si
 from proto.events import GsEvent
 from proto.scenario import Scenario
 
+HELP = """\
+The whole fleet on this machine until Ctrl-C: router, ground station,
+gateway, simulator and one agent per UAV. Prints the gateway URL, the token
+(and the two export lines for curl), the run directory, then one line per
+ground-station event. The CLI finds the run by itself while it is up (the
+session file: $LINECREW_SESSION or .linecrew/session.json). Ctrl-C or
+SIGTERM stops everything.
+"""
+
 
 def add_run_arguments(parser: argparse.ArgumentParser) -> None:
     """Flags shared by ``up`` and ``demo``."""
@@ -29,13 +39,17 @@ def add_run_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--uavs", type=int, help="resize the fleet to N UAVs")
     parser.add_argument("--speedup", type=float, default=1.0, help="mission seconds per second")
     parser.add_argument("--port", type=int, default=0, help="gateway port (default: free)")
-    parser.add_argument("--run-dir", type=pathlib.Path, help="logs and store (runs/<time>)")
+    parser.add_argument(
+        "--run-dir", type=pathlib.Path, help="logs, store and flight log (default runs/<UTC time>)"
+    )
     parser.add_argument(
         "--secure",
         action="store_true",
         help="mutual TLS and access control on the bus (dev certificates in the run directory)",
     )
-    parser.add_argument("--log-level", default="warning")
+    parser.add_argument(
+        "--log-level", default="warning", help="of every process: debug, info, warning, error"
+    )
 
 
 def scenario_from(args: argparse.Namespace) -> Scenario:
@@ -53,6 +67,11 @@ def options_from(args: argparse.Namespace) -> RunOptions:
     )
 
 
+def export_lines(url: str, token: str) -> str:
+    """The shell lines that let ``curl`` (and the CLI) reach this gateway."""
+    return f"export LINECREW_URL={shlex.quote(url)}\nexport LINECREW_TOKEN={shlex.quote(token)}"
+
+
 def event_line(event: GsEvent) -> str:
     """One compact line per ground-station event."""
     who = event.uav_id or event.action_id or ""
@@ -64,7 +83,7 @@ def main(argv: list[str] | None = None) -> int:
     """Run until SIGINT/SIGTERM or until a process dies (exit 1)."""
     parser = argparse.ArgumentParser(
         prog="linecrew up",
-        description=__doc__,
+        description=HELP,
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     add_run_arguments(parser)
@@ -82,6 +101,8 @@ def main(argv: list[str] | None = None) -> int:
                 f"  zenoh     {run.endpoint}\n"
                 f"  logs      {run.run_dir}/\n"
                 f"  try       linecrew status   (the CLI finds this run by itself)\n"
+                f"for curl (and the CLI from anywhere):\n"
+                f"{export_lines(run.url, run.token)}\n"
                 f"Ctrl-C stops everything.",
                 flush=True,
             )

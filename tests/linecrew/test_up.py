@@ -1,8 +1,10 @@
-"""``linecrew up``: everything starts healthy, the printed URL and token work,
-and stopping it (SIGTERM, or even SIGKILL) leaves no process behind."""
+"""``linecrew up``: everything starts healthy, the printed URL and token (and
+the two export lines) work, the run is listed in the session file while it
+is up, and stopping it (SIGTERM, or even SIGKILL) leaves no process behind."""
 
 from __future__ import annotations
 
+import json
 import os
 import re
 import signal
@@ -22,7 +24,8 @@ def survivors(run_dir) -> list[str]:
 
 
 @pytest.fixture
-def up(tmp_path):
+def up(tmp_path, monkeypatch):
+    monkeypatch.setenv("LINECREW_SESSION", str(tmp_path / "session.json"))
     run_dir = tmp_path / "run"
     port = free_port()
     args = [
@@ -37,12 +40,7 @@ def up(tmp_path):
         "--run-dir",
         str(run_dir),
     ]
-    cwd = os.getcwd()
-    os.chdir(tmp_path)  # the session file goes to ./.linecrew
-    try:
-        proc = Process(args, "up")
-    finally:
-        os.chdir(cwd)
+    proc = Process(args, "up")
     try:
         wait_until(
             lambda: "linecrew is up" in proc.output() or proc.popen.poll() is not None,
@@ -61,7 +59,12 @@ def test_up_prints_a_working_url_and_token_and_stops_cleanly(up, tmp_path):
     text = proc.output()
     token = re.search(r"token\s+(\S+)", text).group(1)
     url = f"http://127.0.0.1:{port}"
-    assert url in text and (tmp_path / ".linecrew" / "session.json").is_file()
+    assert url in text
+    exports = dict(re.findall(r"^export (LINECREW_URL|LINECREW_TOKEN)=(\S+)$", text, re.M))
+    assert exports == {"LINECREW_URL": url, "LINECREW_TOKEN": token}
+    [listed] = json.loads((tmp_path / "session.json").read_text())["runs"]
+    assert (listed["url"], listed["token"], listed["run_dir"]) == (url, token, str(run_dir))
+    assert listed["speedup"] == 5
     headers = {"Authorization": f"Bearer {token}"}
 
     def fleet_ready() -> bool:
@@ -81,6 +84,7 @@ def test_up_prints_a_working_url_and_token_and_stops_cleanly(up, tmp_path):
     os.killpg(proc.popen.pid, signal.SIGTERM)
     assert proc.popen.wait(60) == 0, proc.output()
     assert not survivors(run_dir)
+    assert json.loads((tmp_path / "session.json").read_text())["runs"] == []
 
 
 def test_a_killed_up_takes_its_children_with_it(up):
