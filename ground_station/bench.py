@@ -1,11 +1,18 @@
 """``linecrew bench ground-station``: the ground station process measured
 with N light agents over a real router on loopback.
 
+0. Load: ``--preload`` actions (default 200) are submitted in a burst and
+   planned (coalesced) before anything is measured, so that the events below
+   meet a mission of that size in force.
 1. Event -> new plan received: an operator submits an action; the time until
    every agent whose plan changed has received it (p50 / p99 over events).
+   Submit reply: the time until the operator's submit is answered (the
+   action durable, ``accepted``; planning follows), p50 / p99 over every
+   submit, and for one ``--big-inspect``-waypoint inspection.
 2. Plan stability: the plan epochs issued per submitted action (at most
-   one per real trigger), and per UAV per mission-minute over ``--steady-s``
-   seconds in which nothing happens (target 0).
+   one per real trigger), the epochs of adopted background improvements,
+   and per UAV per mission-minute over ``--steady-s`` seconds in which
+   nothing happens (target 0).
 3. Silence -> lost -> replan: an agent process is ``kill -9``ed; the time
    until the ground station announces it lost and replans, against the
    configured ``--link-timeout``.
@@ -15,6 +22,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import os
 import pathlib
 import random
 import subprocess
@@ -31,11 +39,16 @@ from linecrew.bus import Bus, BusConfig
 from linecrew.bus.router_process import router_process
 from linecrew.scenarios import load, with_fleet_size
 from proto import (
+    ActionList,
     ActionReply,
+    ActionState,
     EventKind,
+    GetMetrics,
     GsEvent,
     InspectAction,
     KeySpace,
+    ListActions,
+    MetricsReply,
     Point,
     Role,
     Scenario,
@@ -44,17 +57,49 @@ from proto import (
 )
 
 
-def _inspection(rng: random.Random, index: int) -> SubmitAction:
-    waypoints = [
-        WaypointSpec(
-            position=Point(
-                x_m=rng.uniform(-15, 10), y_m=rng.uniform(0, 20), z_m=rng.uniform(3, 18)
-            ),
-            service_s=5.0,
+def random_inspection(rng: random.Random, points: int = 3) -> InspectAction:
+    """An inspection of ``points`` random waypoints around the paper site's lines."""
+    return InspectAction(
+        waypoints=[
+            WaypointSpec(
+                position=Point(
+                    x_m=rng.uniform(-15, 10), y_m=rng.uniform(0, 20), z_m=rng.uniform(3, 18)
+                ),
+                service_s=5.0,
+            )
+            for _ in range(points)
+        ]
+    )
+
+
+def _inspection(rng: random.Random, index: int, points: int = 3) -> SubmitAction:
+    return SubmitAction(request_id=f"bench-{index}", action=random_inspection(rng, points))
+
+
+def _timed_submit(client: Bus, keys: KeySpace, request: SubmitAction, replies: list[float]) -> None:
+    started = time.perf_counter()
+    client.query(keys.rpc("submit"), request, ActionReply, 10.0)
+    replies.append(time.perf_counter() - started)
+
+
+def _preload(
+    client: Bus, keys: KeySpace, count: int, seed: int, replies: list[float], timeout_s: float
+) -> float:
+    """Submit ``count`` actions in a burst; wait until none is ``accepted``
+    any more. Returns the seconds from the first submit until then."""
+    rng = random.Random(seed + 1000)
+    started = time.perf_counter()
+    for i in range(count):
+        _timed_submit(client, keys, _inspection(rng, 100_000 + i), replies)
+    deadline = time.monotonic() + timeout_s
+    while time.monotonic() < deadline:
+        listed = client.query(
+            keys.rpc("list_actions"), ListActions(states=[ActionState.ACCEPTED]), ActionList, 10.0
         )
-        for _ in range(3)
-    ]
-    return SubmitAction(request_id=f"bench-{index}", action=InspectAction(waypoints=waypoints))
+        if not listed.records:
+            break
+        time.sleep(0.05)
+    return time.perf_counter() - started
 
 
 class _EventWatch:
@@ -93,12 +138,13 @@ def _event_to_plan(
     watch: _EventWatch,
     events: int,
     seed: int,
+    replies: list[float],
 ) -> list[float]:
     rng = random.Random(seed)
     latencies = []
     for i in range(events):
         started = time.perf_counter()
-        client.query(keys.rpc("submit"), _inspection(rng, i), ActionReply, 10.0)
+        _timed_submit(client, keys, _inspection(rng, i), replies)
         replan = watch.wait_for(lambda e: e.kind == EventKind.REPLAN, 10.0, since=started)
         if replan is None:
             continue
@@ -125,24 +171,69 @@ def _event_to_plan(
     return latencies
 
 
+def _cpu_s(pid: int) -> float:
+    """User + system CPU seconds of process ``pid`` so far (Linux /proc)."""
+    fields = pathlib.Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()
+    return (int(fields[11]) + int(fields[12])) / os.sysconf("SC_CLK_TCK")
+
+
+def _improvements(watch: _EventWatch, since: float) -> set[int]:
+    """Epochs of the improvements adopted since ``since``."""
+    return {
+        e.epoch
+        for t, e in watch.items
+        if e.kind == EventKind.REPLAN and t >= since and e.detail.startswith("improvement")
+    }
+
+
+def _settle(client: Bus, keys: KeySpace, timeout_s: float = 120.0) -> float:
+    """Wait until the gs's plan is final (the background improvement of the
+    last trigger's state done); returns the seconds it took."""
+    started = time.perf_counter()
+    while time.perf_counter() - started < timeout_s:
+        metrics = client.query(keys.rpc("metrics"), GetMetrics(), MetricsReply, 10.0)
+        if metrics.values.get("planner_settled") == 1.0:
+            break
+        time.sleep(0.1)
+    return time.perf_counter() - started
+
+
 def _stability(
-    watch: _EventWatch, since: float, uavs: int, events: int, steady_s: float
+    client: Bus,
+    keys: KeySpace,
+    watch: _EventWatch,
+    since: float,
+    counts: tuple[int, int],
+    steady_s: float,
+    gs_pid: int,
 ) -> dict[str, float]:
-    """Epochs per trigger during the submissions (from ``since``), then per
-    UAV per minute while nothing happens (the gs runs at x1)."""
-    changes = [(t, e) for t, e in watch.items if e.kind == EventKind.PLAN_CHANGED]
-    epochs = {e.epoch for t, e in changes if t >= since}
-    before = {e.epoch for t, e in changes if t < since}
+    """Epochs per trigger during the submissions (from ``since``), how long
+    the improvement of the last state ran, then epochs per UAV per minute and
+    the gs's CPU while nothing happens (the gs runs at x1)."""
+    uavs, events = counts
+    settle_s = _settle(client, keys)
     quiet_from = time.perf_counter()
+    changes = [(t, e) for t, e in watch.items if e.kind == EventKind.PLAN_CHANGED]
+    improved = _improvements(watch, since)
+    epochs = {e.epoch for t, e in changes if t >= since} - improved
+    before = {e.epoch for t, e in changes if t < since}
+    cpu = _cpu_s(gs_pid)
     time.sleep(steady_s)
+    cpu = _cpu_s(gs_pid) - cpu
+    improved = _improvements(watch, since)  # adopted late: counted apart, not as steady
     quiet = {
         e.epoch
         for t, e in watch.items
-        if e.kind == EventKind.PLAN_CHANGED and t >= quiet_from and e.epoch not in epochs | before
+        if e.kind == EventKind.PLAN_CHANGED
+        and t >= quiet_from
+        and e.epoch not in epochs | before | improved
     }
     return {
         "epochs_per_submit": len(epochs) / max(1, events),
+        "improvement_epochs": float(len(improved)),
+        "improvement_settle_s": settle_s,
         "steady_epochs_per_uav_min": len(quiet) / uavs / (steady_s / 60.0),
+        "steady_gs_cpu_pct": 100.0 * cpu / steady_s,
     }
 
 
@@ -187,10 +278,24 @@ def _silence_to_lost(
     }
 
 
+def _pct(values: list[float], q: float) -> float:
+    ordered = sorted(values)
+    if not ordered:
+        return float("nan")
+    return ordered[min(len(ordered) - 1, int(q * len(ordered)))] * 1e3
+
+
 def run(
-    uavs: int, events: int, link_timeout_s: float, lease_ms: int, seed: int, steady_s: float = 20.0
+    uavs: int,
+    events: int,
+    link_timeout_s: float,
+    lease_ms: int,
+    seed: int,
+    steady_s: float = 20.0,
+    preload: int = 200,
+    big_inspect: int = 2000,
 ) -> dict:
-    """Run both measurements; returns the numbers."""
+    """Run the measurements; returns the numbers."""
     scenario = with_fleet_size(load("paper"), uavs + 1)
     keys = KeySpace(scenario.site.id)
     with tempfile.TemporaryDirectory() as tmp, router_process(keys.site, lease_ms) as endpoint:
@@ -229,24 +334,50 @@ def run(
                     agents[spec.id] = LightAgent(config, scenario, spec.id)
                 while not all(a.plans for a in agents.values()):
                     time.sleep(0.01)
+                replies: list[float] = []
+                preload_s = _preload(client, keys, preload, seed, replies, 120.0)
+                _settle(client, keys)  # the background improvement of the loaded plan
                 submitted = time.perf_counter()
-                latencies = sorted(_event_to_plan(client, keys, agents, watch, events, seed))
-                stability = _stability(watch, submitted, uavs, events, steady_s)
+                latencies = sorted(
+                    _event_to_plan(client, keys, agents, watch, events, seed, replies)
+                )
+                stability = _stability(
+                    client, keys, watch, submitted, (uavs, events), steady_s, gs.pid
+                )
                 lost = _silence_to_lost(
                     endpoint, scenario_file, scenario.fleet.uavs[-1].id, lease_ms, watch
                 )
+                big: list[float] = []
+                if big_inspect > 0:
+                    request = _inspection(random.Random(seed + 7), 999_999, big_inspect)
+                    _timed_submit(client, keys, request, big)
+                    replies += big
+                metrics = client.query(keys.rpc("metrics"), GetMetrics(), MetricsReply, 10.0)
         finally:
             for agent in agents.values():
                 agent.close()
             gs.terminate()
             gs.wait(10)
-    p = lambda q: latencies[min(len(latencies) - 1, int(q * len(latencies)))] * 1e3  # noqa: E731
+    values = metrics.values
     return {
         "agents": uavs,
+        "actions_preloaded": preload,
+        "preload_planned_s": preload_s,
         "events": len(latencies),
-        "event_to_plan_p50_ms": p(0.5) if latencies else float("nan"),
-        "event_to_plan_p99_ms": p(0.99) if latencies else float("nan"),
+        "event_to_plan_p50_ms": _pct(latencies, 0.5),
+        "event_to_plan_p99_ms": _pct(latencies, 0.99),
+        "submit_reply_p50_ms": _pct(replies, 0.5),
+        "submit_reply_p99_ms": _pct(replies, 0.99),
+        "submit_reply_big_inspect_ms": big[0] * 1e3 if big else float("nan"),
+        "big_inspect_waypoints": big_inspect,
         **stability,
+        "replans": values.get("replans", 0.0),
+        "replans_incremental": values.get("replans_incremental", 0.0),
+        "replans_rebuilt": values.get("replans_rebuilt", 0.0),
+        "replan_triggers": values.get("replan_triggers", 0.0),
+        "improvements_adopted": values.get("improvements_adopted", 0.0),
+        "improvements_rejected": values.get("improvements_rejected", 0.0),
+        "plan_objective_s": values.get("plan_objective_s", float("nan")),
         "link_timeout_s": link_timeout_s,
         **lost,
     }
@@ -265,10 +396,21 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--lease-ms", type=int, default=500, help="zenoh transport lease")
     parser.add_argument("--seed", type=int, default=1)
     parser.add_argument("--steady-s", type=float, default=20.0, help="quiet time watched (s)")
+    parser.add_argument("--preload", type=int, default=200, help="actions in force first")
+    parser.add_argument(
+        "--big-inspect", type=int, default=2000, help="waypoints of the big submit (0: none)"
+    )
     parser.add_argument("--json", action="store_true", help="print JSON")
     args = parser.parse_args(argv)
     results = run(
-        args.uavs, args.events, args.link_timeout, args.lease_ms, args.seed, args.steady_s
+        args.uavs,
+        args.events,
+        args.link_timeout,
+        args.lease_ms,
+        args.seed,
+        args.steady_s,
+        args.preload,
+        args.big_inspect,
     )
     if args.json:
         print(json.dumps(results, indent=2))

@@ -16,6 +16,13 @@ class GsConfig:
     link_timeout_s: float = 5.0  # silence before a UAV is lost; > the agents' 3 s
     watchdog_period_s: float = 0.1  # how often the watchdog looks
     battery_margin_fraction: float = 0.1  # battery below the plan by this much -> replan
+    improve: int = 1  # anytime improvement of the live plan in the background (0: off)
+    improve_rounds: int = 200  # local-search rounds per attempt (deterministic)
+    improve_margin: float = 0.02  # adopt an improved plan only if better by this fraction
+    freeze_horizon_s: float = 30.0  # tasks starting within this (mission s) never change
+    improve_attempts: int = 10  # attempts per state at most, while each gains
+    session_window_s: float = 10.0  # mission s a planning session serves incremental replans
+    improve_delay_s: float = 0.5  # quiet wall seconds after a trigger before improving
 
     @classmethod
     def from_env(cls, **overrides: object) -> GsConfig:
@@ -24,6 +31,7 @@ class GsConfig:
         for field in dataclasses.fields(cls):
             raw = os.environ.get(f"LINECREW_GS_{field.name.upper()}")
             if raw is not None:
-                values[field.name] = float(raw) if field.type == "float" else raw
+                convert = {"float": float, "int": lambda v: int(float(v))}.get(field.type, str)
+                values[field.name] = convert(raw)
         values.update({k: v for k, v in overrides.items() if v is not None})
         return cls(**values)  # type: ignore[arg-type]

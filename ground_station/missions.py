@@ -4,8 +4,11 @@ It validates and stores operator requests (idempotent on the client's
 request id, durable before the reply), hands agents' reports to
 :class:`~ground_station.agent_reports.AgentReports`, and replans on every
 trigger of the paper, sending a plan with a new epoch to each UAV whose work
-changed. It does no I/O of its own besides the store: plans and events leave
-through the callables given.
+changed. Requests never wait for planning: they reply once the change is
+committed (a new action is ``accepted``) and trigger the planning worker
+(:class:`~ground_station.plan_worker.PlanWorker`), which moves actions to
+``planned`` or ``failed``. It does no I/O of its own besides the store:
+plans and events leave through the callables given.
 """
 
 from __future__ import annotations
@@ -20,7 +23,9 @@ from ground_station.action_book import ActionBook
 from ground_station.agent_reports import AgentReports
 from ground_station.event_log import EventLog
 from ground_station.fleet_monitor import Change, FleetMonitor
-from ground_station.lifecycle import TERMINAL, ActionEvent
+from ground_station.lifecycle import TERMINAL, TRANSITIONS, ActionEvent
+from ground_station.plan_worker import PlanWorker
+from ground_station.replan_jobs import Computed, Job, ReplanOutcome
 from ground_station.replanner import Replanner
 from ground_station.store import Store
 from ground_station.validation import validate
@@ -90,6 +95,8 @@ class MissionManager:
         replanner: Replanner,
         clock: Callable[[], float],
         battery_margin_fraction: float = 0.1,
+        improve: bool = True,
+        improve_delay_s: float = 0.5,
     ) -> None:
         self.scenario = scenario
         self.store = store
@@ -99,13 +106,14 @@ class MissionManager:
         self.clock = clock
         self.book = ActionBook(store, events, clock)
         self._retried_s = clock()
+        self.worker = PlanWorker(self, improve=improve, improve_delay_s=improve_delay_s)
         self.reports = AgentReports(
             scenario=scenario,
             book=self.book,
             monitor=monitor,
             events=events,
             replanner=replanner,
-            replan=self.replan,
+            replan=self.request_replan,
             battery_margin_fraction=battery_margin_fraction,
         )
 
@@ -129,13 +137,24 @@ class MissionManager:
             case GetPlans(uav_id=uav_id):
                 plans = self.replanner.plans
                 chosen = [plans[uav_id]] if uav_id in plans else [] if uav_id else plans.values()
-                return PlansReply(plans=list(chosen))
+                return PlansReply(plans=list(chosen), **self.plan_quality())
             case GetHistory(after_seq=after, limit=limit):
                 return HistoryReply(events=self.store.events(after, limit))
         raise RequestError(f"unsupported request {type(request).__name__}")
 
+    def plan_quality(self) -> dict[str, float | None]:
+        """The live plan's objective (seconds: weight-averaged completion +
+        makespan), how long ago an improvement was adopted, and its gap to
+        the best plan seen for the same state."""
+        rp = self.replanner
+        objective = rp.objective[1] if rp.objective else None
+        best = rp.best_objective[1] if rp.best_objective else None
+        gap = (objective - best) / best if objective is not None and best else None
+        ago = self.clock() - rp.improved_s if rp.improved_s is not None else None
+        return {"objective_s": objective, "improved_ago_s": ago, "gap_to_best": gap}
+
     def submit(self, request: SubmitAction) -> ActionRecord:
-        """Accept an action: validated, stored durably, then planned."""
+        """Accept an action: validated, stored durably, then planned (later)."""
         existing = self.store.action_by_request(request.request_id)
         if existing is not None:
             if existing.action != request.action:
@@ -160,7 +179,7 @@ class MissionManager:
         self.events.emit(
             EventKind.ACTION_ACCEPTED, action_id=action_id, detail=type(request.action).__name__
         )
-        self.replan(f"action {action_id} added")
+        self.request_replan(f"action {action_id} added")
         return self.book.record(action_id)
 
     def modify(self, request: ModifyAction) -> ActionRecord:
@@ -179,7 +198,7 @@ class MissionManager:
             inventory.reserve(self.scenario.site, others, action)
         self.book.save(msgspec.structs.replace(record, action=action), record.state, "modified")
         self.events.emit(EventKind.ACTION_CHANGED, action_id=record.action_id)
-        self.replan(f"action {record.action_id} changed")
+        self.request_replan(f"action {record.action_id} changed")
         return self.book.record(record.action_id)
 
     def cancel(self, request: CancelAction) -> ActionRecord:
@@ -189,7 +208,7 @@ class MissionManager:
             return record
         self.book.transition(record, ActionEvent.CANCEL, "cancelled by operator")
         self.events.emit(EventKind.ACTION_CANCELLED, action_id=record.action_id)
-        self.replan(f"action {record.action_id} cancelled")
+        self.request_replan(f"action {record.action_id} cancelled", stale=True)
         return self.book.record(record.action_id)
 
     # -- agents ----------------------------------------------------------------
@@ -203,7 +222,7 @@ class MissionManager:
             else:
                 self._void_segments(uav_id)
         if changes:
-            self.replan(", ".join(f"{u} {c}" for u, c in changes))
+            self.request_replan(", ".join(f"{u} {c}" for u, c in changes), stale=True)
         for uav_id, change in changes:
             if change == Change.BACK:
                 self.reports.release(uav_id)
@@ -231,18 +250,59 @@ class MissionManager:
             return
         self._retried_s = now
         if self.store.actions([ActionState.ACCEPTED]):
-            self.replan("retry of actions waiting for a UAV")
+            self.request_replan("retry of actions waiting for a UAV")
 
     # -- planning --------------------------------------------------------------
 
+    def request_replan(self, reason: str, *, stale: bool = False) -> None:
+        """Trigger a replan (returns at once; the worker plans). ``stale``:
+        the change makes a replan in flight outdated (it is run again)."""
+        if stale:
+            self.replanner.bump()
+        self.worker.trigger(reason)
+
     def replan(self, reason: str) -> list[Plan]:
-        """Plan the actions in force; returns the plans that changed."""
-        records = self.store.actions(
+        """Plan the actions in force now, synchronously; returns the plans
+        that changed."""
+        changed = self.finish_replan(self.replanner.compute(self.prepare_replan(reason)))
+        return changed or []
+
+    def in_force(self) -> list[ActionRecord]:
+        return self.store.actions(
             [ActionState.ACCEPTED, ActionState.PLANNED, ActionState.IN_PROGRESS]
         )
-        outcome = self.replanner.replan(records, self.clock(), reason)
+
+    def prepare_replan(self, reason: str) -> Job:
+        """A replan's inputs, now (on the loop)."""
+        return self.replanner.prepare(self.in_force(), self.clock(), reason)
+
+    def prepare_improvement(self) -> Job:
+        """An improvement attempt's inputs, now (on the loop)."""
+        return self.replanner.prepare_improvement(self.in_force(), self.clock())
+
+    def finish_replan(self, computed: Computed) -> list[Plan] | None:
+        """Commit a computed replan (on the loop) and move its actions on;
+        the plans that changed, or None if it was dropped as outdated."""
+        outcome = self.replanner.commit(computed)
+        if outcome is None:
+            return None
+        self._apply(outcome, computed.job.records)
+        return outcome.changed
+
+    def finish_improvement(self, computed: Computed | None, interrupted: bool = False) -> None:
+        """Adopt an improvement if the hysteresis lets it through (on the loop)."""
+        outcome = self.replanner.adopt(computed, interrupted)
+        if outcome is not None and computed is not None:
+            self._apply(outcome, computed.job.records)
+
+    def _apply(self, outcome: ReplanOutcome, records: list[ActionRecord]) -> None:
+        """Move each action on as the plan says; an action whose state the
+        event leaves alone (as of the replan's inputs) is not read again."""
+        before = {r.action_id: r.state for r in records}
         for action_id, (event, reason_text) in outcome.action_events.items():
+            state = before.get(action_id)
+            if state is not None and TRANSITIONS.get((state, event)) == state:
+                continue
             record = self.store.action(action_id)
             if record is not None and record.state not in TERMINAL:
                 self.book.transition(record, event, reason_text)
-        return outcome.changed

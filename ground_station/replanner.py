@@ -1,12 +1,14 @@
 """Runs the planner on the mission's current state and dispatches the result:
 a new epoch for the plans that changed, stored before they are sent, and
-the lifecycle events the new plan implies for each action."""
+the lifecycle events the new plan implies for each action. Every replan and
+every improvement goes through one incremental planner session
+(:mod:`ground_station.live_plan`); the planning worker
+(:mod:`ground_station.plan_worker`) runs them off the request path."""
 
 from __future__ import annotations
 
 import dataclasses
 import logging
-import math
 import time
 from collections.abc import Callable
 
@@ -15,49 +17,42 @@ import msgspec
 from ground_station import planner as pl
 from ground_station.event_log import EventLog
 from ground_station.fleet_monitor import FleetMonitor
+from ground_station.fleet_state import AIRBORNE, drop_done_home, uavs_now
 from ground_station.lifecycle import ActionEvent
-from ground_station.planning import UavNow, build_problem, monitor_starts, same_work, to_tasks
+from ground_station.live_plan import (
+    LivePlan,
+    Objective,
+    accept,
+    better_by,
+    freeze_broken,
+    frozen_parts,
+    frozen_tasks,
+)
+from ground_station.planning import build_problem, monitor_starts, same_work, to_tasks
+from ground_station.replan_jobs import Computed, ImproveSettings, Job, ReplanOutcome, ReplanStats
 from ground_station.store import Store
 from proto.events import EventKind
 from proto.mission import ActionRecord
-from proto.plan import DeliverTask, GoHomeTask, MonitorTask, Plan
+from proto.plan import Plan
 from proto.scenario import Scenario
-from proto.telemetry import FlightState
 
 log = logging.getLogger(__name__)
+
+CONVERGED = 0.001
+"""An improvement attempt that gains less than this fraction over the last
+one has converged: no more attempts on this state."""
 
 IMPOSSIBLE = frozenset({"unreachable_with_full_battery", "unknown_tool"})
 """Unplaced reasons that no change of fleet state can cure: the action fails."""
 
-ON_PAD_M = 1.0
-"""A landed UAV this close (horizontally) to a station is on its pad."""
-
-AIRBORNE = frozenset({FlightState.FLYING, FlightState.TAKING_OFF, FlightState.LANDING})
-
-
-@dataclasses.dataclass
-class ReplanOutcome:
-    """What one replan did."""
-
-    epoch: int
-    changed: list[Plan]
-    action_events: dict[str, tuple[ActionEvent, str]]
-    planning_time_s: float
-
-
-@dataclasses.dataclass
-class ReplanStats:
-    """Count and latency of replans."""
-
-    count: int = 0
-    total_s: float = 0.0
-    last_s: float = 0.0
-    plans_sent: int = 0
-    unchanged: int = 0  # replans that changed no UAV's plan (no event, no epoch)
-
 
 class Replanner:
-    """Keeps the current plan of every UAV and replaces it on demand."""
+    """Keeps the current plan of every UAV and replaces it on demand.
+
+    Every replan goes through the one incremental session of
+    :class:`~ground_station.live_plan.LivePlan`; ``replan`` does a whole
+    replan at once, ``prepare`` / ``compute`` / ``commit`` split it so that
+    ``compute`` (pure planning) runs off the loop."""
 
     def __init__(
         self,
@@ -68,6 +63,8 @@ class Replanner:
         events: EventLog,
         send: Callable[[Plan], None],
         planner_options: pl.Options | None = None,
+        improve: ImproveSettings | None = None,
+        session_window_s: float = 10.0,
     ) -> None:
         self.scenario = scenario
         self.store = store
@@ -75,8 +72,16 @@ class Replanner:
         self.events = events
         self.send = send
         self.options = planner_options
+        self.improve_settings = improve or ImproveSettings()
+        self.live = LivePlan(planner_options, session_window_s)
         self.plans: dict[str, Plan] = store.latest_plans()
         self.stats = ReplanStats()
+        self.version = 0  # bumped by changes that make a replan in flight stale
+        self.objective: Objective | None = None  # of the live plan
+        self.best_objective: Objective | None = None  # best seen for this state
+        self.improved_s: float | None = None  # mission s of the last adopted improvement
+        self._attempts = 0  # improvement attempts on the current state
+        self._restart = False  # the next attempt starts from a fresh construction
         self._resend: set[str] = set()
         # uav -> task id -> the epoch since which its plan holds that task
         # (restored conservatively as the stored plan's own epoch)
@@ -87,6 +92,11 @@ class Replanner:
     def resend(self, uav_id: str) -> None:
         """Give ``uav_id`` a fresh plan (higher epoch) at the next replan."""
         self._resend.add(uav_id)
+
+    def bump(self) -> None:
+        """Something changed that a replan in flight did not see: its result
+        is dropped (and the replan run again)."""
+        self.version += 1
 
     def assigned_since(self, uav_id: str, task_id: str) -> int | None:
         """The epoch since which ``uav_id``'s plan holds ``task_id`` without a
@@ -116,28 +126,82 @@ class Replanner:
             self.plans[uav_id] = msgspec.structs.replace(plan, tasks=rest)
             since = self._since.get(uav_id, {})
             self._since[uav_id] = {t.task_id: since[t.task_id] for t in rest if t.task_id in since}
+            self.live.invalidate()  # the session still holds the task
+            self.bump()
+
+    # -- replans -----------------------------------------------------------------
 
     def replan(self, records: list[ActionRecord], now_s: float, reason: str) -> ReplanOutcome:
         """Plan ``records`` (the actions in force) from the fleet's state now."""
-        site, fleet = self.scenario.site, self.scenario.fleet
+        outcome = self.commit(self.compute(self.prepare(records, now_s, reason)))
+        assert outcome is not None  # nothing can change in between
+        return outcome
+
+    def prepare(self, records: list[ActionRecord], now_s: float, reason: str) -> Job:
+        """The inputs of a replan, as the mission stands (on the loop)."""
         in_force = {r.action_id for r in records}
-        starts = monitor_starts(self.plans.values())
-        problem = build_problem(
-            site, fleet, self._uavs_now(in_force), records, now_s, monitor_starts=starts
+        return Job(
+            records=list(records),
+            now_s=now_s,
+            reason=reason,
+            uavs=uavs_now(self.scenario, self.monitor, self.plans, in_force),
+            starts=monitor_starts(self.plans.values()),
+            version=self.version,
         )
+
+    def compute(self, job: Job) -> Computed:
+        """Plan ``job`` on the live session (pure: any thread, one at a time)."""
+        site, fleet = self.scenario.site, self.scenario.fleet
+        capacities = {u.id: fleet.type_of(u.id).battery_wh for u in fleet.uavs}
+
+        def build(base_s: float) -> pl.Problem:
+            return build_problem(
+                site, fleet, job.uavs, job.records, base_s, monitor_starts=job.starts
+            )
+
         started = time.perf_counter()
         try:
-            result = pl.plan(problem, self.options)
+            planned = self.live.replan(build, job.now_s, capacities)
         except pl.PlanningProblemError as exc:  # fleet reports that contradict each other
-            log.error("replan refused (%s): %s; plans kept", reason, exc)
-            self.events.emit(EventKind.FAULT, detail=f"replan refused: {exc}; plans kept")
-            return ReplanOutcome(self.store.counter("epoch"), [], {}, 0.0)
+            self.live.invalidate()
+            return Computed(job, {}, error=str(exc))
+        except Exception:
+            self.live.invalidate()
+            raise
         elapsed = time.perf_counter() - started
+        return Computed(
+            job,
+            self._wire(planned.plan, job.records, planned.base_s),
+            result=planned.plan,
+            elapsed_s=elapsed,
+            incremental=planned.incremental,
+        )
+
+    def _wire(self, result: pl.Plan, records: list[ActionRecord], base_s: float) -> dict:
+        site, fleet = self.scenario.site, self.scenario.fleet
         by_id = {r.action_id: r for r in records}
+        return {up.uav_id: to_tasks(up, site, fleet, by_id, base_s) for up in result.uavs}
+
+    def commit(self, computed: Computed) -> ReplanOutcome | None:
+        """Adopt a computed plan (on the loop): a new epoch for the UAVs whose
+        work changed, stored, then sent. None if the mission changed since
+        ``prepare`` in a way the result did not see: it is dropped."""
+        job = computed.job
+        if job.version != self.version:
+            self.live.invalidate()
+            self.stats.dropped += 1
+            return None
+        if computed.result is None:
+            log.error("replan refused (%s): %s; plans kept", job.reason, computed.error)
+            detail = f"replan refused: {computed.error}; plans kept"
+            self.events.emit(EventKind.FAULT, detail=detail)
+            return ReplanOutcome(self.store.counter("epoch"), [], {}, 0.0)
+        result, elapsed = computed.result, computed.elapsed_s
         new_tasks = {
-            up.uav_id: self._drop_done_home(up.uav_id, to_tasks(up, site, fleet, by_id, now_s))
-            for up in result.uavs
+            uav: drop_done_home(self.scenario, self.monitor, uav, tasks)
+            for uav, tasks in computed.tasks.items()
         }
+        fleet = self.scenario.fleet
         changed_ids = [
             u.id
             for u in fleet.uavs
@@ -145,6 +209,7 @@ class Replanner:
         ]
         epoch = self.store.counter("epoch")
         changed: list[Plan] = []
+        now_s = job.now_s
         if changed_ids:
             epoch = self.store.next_counter("epoch")
             changed = [
@@ -167,70 +232,132 @@ class Replanner:
         self.stats.count += 1
         self.stats.total_s += elapsed
         self.stats.last_s = elapsed
+        if computed.candidate is None:
+            if computed.incremental:
+                self.stats.incremental += 1
+            else:
+                self.stats.rebuilds += 1
+            self._attempts = 0  # a new state: improvement may try again
+            self._restart = False
+            self.objective = self.live.objective()
+            self.best_objective = self.objective
         if not changed:  # counted in /metrics, not worth an event
             self.stats.unchanged += 1
         else:
+            how = "incremental" if computed.incremental else "rebuilt"
+            if computed.candidate is not None:
+                how = "improved"
             self.events.emit(
                 EventKind.REPLAN,
                 epoch=epoch,
-                detail=f"{reason}; {len(changed)} plan(s) changed in {elapsed * 1e3:.1f} ms",
+                detail=f"{job.reason}; {len(changed)} plan(s) changed in "
+                f"{elapsed * 1e3:.1f} ms ({how})",
             )
-        return ReplanOutcome(epoch, changed, _action_events(records, new_tasks, result), elapsed)
+        action_events = _action_events(job.records, new_tasks, result)
+        return ReplanOutcome(epoch, changed, action_events, elapsed)
 
-    def _drop_done_home(self, uav_id: str, tasks: list) -> list:
-        """A plan that only sends a UAV to the pad it already sits on asks
-        nothing: it is empty (else the agent would "complete" it at once,
-        over and over)."""
-        telemetry = self.monitor.telemetry(uav_id)
-        if len(tasks) != 1 or not isinstance(tasks[0], GoHomeTask) or telemetry is None:
-            return tasks
-        station = self.scenario.site.station(tasks[0].station_id)
-        p = telemetry.position
-        on_pad = (
-            telemetry.flight_state == FlightState.LANDED
-            and station is not None
-            and math.hypot(p.x_m - station.position.x_m, p.y_m - station.position.y_m) <= ON_PAD_M
+    # -- improvement ------------------------------------------------------------
+
+    def wants_improvement(self) -> bool:
+        """Whether an improvement attempt is due on the current state."""
+        s = self.improve_settings
+        return (
+            s.enabled
+            and self._attempts < s.attempts
+            and self.live.session is not None
+            and not self.live.stale
         )
-        return [] if on_pad else tasks
+
+    def prepare_improvement(self, records: list[ActionRecord], now_s: float) -> Job:
+        """An improvement attempt's inputs (on the loop): the tasks frozen now."""
+        job = self.prepare(records, now_s, "improvement")
+        job.frozen = self._frozen(now_s)
+        return job
+
+    def _frozen(self, now_s: float) -> dict[str, list]:
+        """The tasks an improvement must keep: those started or starting
+        within the freeze horizon, of every UAV that has begun its plan (is
+        in the air or executing a task). A UAV still idle on its pad has
+        done nothing a changed plan would undo, so its plan stays open."""
+        begun = {
+            uav: plan.tasks
+            for uav, plan in self.plans.items()
+            if (status := self.monitor.status(uav)) is not None
+            and (status.task_id is not None or self._airborne(uav))
+        }
+        return frozen_tasks(begun, now_s, self.improve_settings.freeze_s)
+
+    def _airborne(self, uav_id: str) -> bool:
+        telemetry = self.monitor.telemetry(uav_id)
+        return telemetry is not None and telemetry.flight_state in AIRBORNE
+
+    def improve(self, job: Job, should_stop: Callable[[], bool] = lambda: False) -> Computed | None:
+        """Try to improve the live plan (pure: on the worker's thread). The
+        result is committed only through ``adopt``."""
+        s = self.improve_settings
+        started = time.perf_counter()
+        frozen = frozen_parts(job.frozen or {})
+        restart = self._restart and self.live.can_restart(frozen)
+        candidate = self.live.improve(
+            s.rounds, s.seed + self._attempts, frozen, should_stop, restart=restart
+        )
+        if candidate is None:
+            return None
+        tasks = self._wire(candidate.plan, job.records, candidate.base_s)
+        return Computed(
+            job,
+            tasks,
+            result=candidate.plan,
+            elapsed_s=time.perf_counter() - started,
+            candidate=candidate,
+        )
+
+    def adopt(self, computed: Computed | None, interrupted: bool = False) -> ReplanOutcome | None:
+        """The hysteresis (on the loop): adopt an improved plan only if it is
+        better by the margin and keeps every frozen task; else restore."""
+        if computed is None or computed.candidate is None:
+            if interrupted:
+                self.stats.improvements_interrupted += 1
+            else:
+                self._attempts = self.improve_settings.attempts  # nothing to improve
+            return None
+        candidate, job = computed.candidate, computed.job
+        self.stats.improvements_tried += 1
+        self._attempts += 1
+        if job.version != self.version:
+            candidate.restore()
+            self.stats.improvements_interrupted += 1
+            return None
+        if self.best_objective is None or candidate.after < self.best_objective:
+            self.best_objective = candidate.after
+        s = self.improve_settings
+        frozen = self._frozen(job.now_s)
+        ok, why = accept(candidate.before, candidate.after, frozen, computed.tasks, s.margin)
+        if not ok:
+            candidate.restore()
+            self.stats.improvements_rejected += 1
+            best = self.live.kept_objective() or candidate.before
+            gaining = better_by(best, candidate.after, CONVERGED)
+            if not freeze_broken(frozen, computed.tasks):
+                self.live.keep(candidate)  # later attempts go on from the best: gains add up
+            # a search that stopped gaining starts again from another construction;
+            # when none is left (or the plan is flying) the state is left alone
+            self._restart = not gaining
+            if not gaining and not self.live.can_restart(frozen_parts(frozen)):
+                self._attempts = s.attempts
+            log.debug("improvement rejected: %s", why)
+            return None
+        self.live.take(candidate)
+        computed.job = dataclasses.replace(job, reason=f"improvement: {why}")
+        outcome = self.commit(computed)
+        self.stats.improvements_adopted += 1
+        self.objective = candidate.after
+        self.improved_s = job.now_s
+        return outcome
 
     def _tasks(self, uav_id: str) -> list:
         plan = self.plans.get(uav_id)
         return plan.tasks if plan else []
-
-    def _uavs_now(self, in_force: set[str]) -> list[UavNow]:
-        site, fleet = self.scenario.site, self.scenario.fleet
-        uavs = []
-        for spec in fleet.uavs:
-            telemetry = self.monitor.telemetry(spec.id)
-            home = site.station(spec.home_station)
-            capacity = fleet.type_of(spec.id).battery_wh
-            uavs.append(
-                UavNow(
-                    uav_id=spec.id,
-                    position=telemetry.position if telemetry else home.position,
-                    energy_wh=min(capacity, telemetry.battery_wh) if telemetry else capacity,
-                    available=self.monitor.available(spec.id),
-                    airborne=bool(telemetry and telemetry.flight_state in AIRBORNE),
-                    tool=telemetry.tool if telemetry else None,
-                    running_action=self._running_action(spec.id, in_force),
-                )
-            )
-        return uavs
-
-    def _running_action(self, uav_id: str, in_force: set[str]) -> str | None:
-        """The monitoring action in force the UAV is executing, or the delivery
-        whose tool its telemetry says it holds, if any."""
-        status, telemetry = self.monitor.status(uav_id), self.monitor.telemetry(uav_id)
-        plan = self.plans.get(uav_id)
-        if status is None or status.task_id is None or plan is None:
-            return None
-        for task in plan.tasks:
-            if task.task_id != status.task_id or task.action_id not in in_force:
-                continue
-            holds_tool = telemetry is not None and telemetry.tool == getattr(task, "tool", None)
-            if isinstance(task, MonitorTask) or (isinstance(task, DeliverTask) and holds_tool):
-                return task.action_id
-        return None
 
 
 def _action_events(

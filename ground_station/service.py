@@ -1,6 +1,8 @@
 """The ground station process: the mission manager wired to the bus.
 
 One asyncio loop does all the work; Zenoh callbacks only hand samples over.
+Planning runs in one worker (:mod:`ground_station.plan_worker`): requests
+reply once their change is committed, and the worker's thread plans.
 Inputs: agents' telemetry, status, outcomes and liveliness tokens; RPC
 queries on ``gs/rpc/{op}``; plan resync queries on ``uav/*/plan``. Outputs:
 plans on ``uav/{id}/plan``, events on ``gs/events``, the ``alive/gs/{id}``
@@ -19,6 +21,7 @@ from ground_station.config import GsConfig
 from ground_station.event_log import EventLog
 from ground_station.fleet_monitor import FleetMonitor
 from ground_station.missions import MissionManager
+from ground_station.replan_jobs import ImproveSettings
 from ground_station.replanner import Replanner
 from ground_station.store import Store
 from linecrew.bus import Bus
@@ -55,6 +58,14 @@ class GroundStation:
             monitor=self.monitor,
             events=self.events,
             send=lambda plan: bus.publish(self.keys.plan(plan.uav_id), plan),
+            improve=ImproveSettings(
+                enabled=bool(config.improve),
+                rounds=config.improve_rounds,
+                margin=config.improve_margin,
+                freeze_s=config.freeze_horizon_s,
+                attempts=config.improve_attempts,
+            ),
+            session_window_s=config.session_window_s,
         )
         self.manager = MissionManager(
             scenario=scenario,
@@ -64,6 +75,8 @@ class GroundStation:
             replanner=self.replanner,
             clock=clock,
             battery_margin_fraction=config.battery_margin_fraction,
+            improve=bool(config.improve),
+            improve_delay_s=config.improve_delay_s,
         )
 
     async def run(self, shutdown: Shutdown) -> None:
@@ -93,6 +106,7 @@ class GroundStation:
                     group.create_task(self._consume(outcomes, self._on_outcome)),
                     group.create_task(self._consume(tokens, self._on_token)),
                     group.create_task(self._watchdog()),
+                    group.create_task(self.manager.worker.run()),
                 ]
                 await shutdown.wait_async()
                 for task in tasks:
@@ -147,23 +161,43 @@ class GroundStation:
 
     def _plan_query(self, request: GetPlans) -> PlansReply:
         plan = self.replanner.plans.get(request.uav_id or "")
-        return PlansReply(plans=[plan] if plan else [])
+        return PlansReply(plans=[plan] if plan else [], **self.manager.plan_quality())
 
     def metrics(self) -> dict[str, float]:
         """Counters and timings in one place."""
         stats, counters = self.replanner.stats, self.manager.reports.counters
+        worker = self.manager.worker.stats
         values: dict[str, float] = {
             "replans": stats.count,
             "replan_seconds_total": stats.total_s,
             "replan_seconds_last": stats.last_s,
             "plans_sent": stats.plans_sent,
             "replans_unchanged": stats.unchanged,
+            "replans_incremental": stats.incremental,
+            "replans_rebuilt": stats.rebuilds,
+            "replans_dropped": stats.dropped,
+            "replan_triggers": worker.triggers,
+            "replan_triggers_coalesced": worker.coalesced,
+            "improvements_tried": stats.improvements_tried,
+            "improvements_adopted": stats.improvements_adopted,
+            "improvements_rejected": stats.improvements_rejected,
+            "improvements_interrupted": stats.improvements_interrupted,
+            "planner_settled": float(self.manager.worker.settled),
             "outcomes": counters.outcomes,
             "stale_outcomes": counters.stale_outcomes,
             "battery_replans": counters.battery_replans,
             "epoch": self.store.counter("epoch"),
             "bus_malformed": sum(self.bus.stats.malformed.values()),
         }
+        quality = {
+            "plan_objective_s": "objective_s",
+            "plan_improved_ago_s": "improved_ago_s",
+            "plan_gap_to_best": "gap_to_best",
+        }
+        plan_quality = self.manager.plan_quality()
+        for name, key in quality.items():
+            if plan_quality[key] is not None:
+                values[name] = float(plan_quality[key])
         for record in self.store.actions():
             key = f"actions_{record.state}"
             values[key] = values.get(key, 0) + 1

@@ -44,6 +44,7 @@ BENCHES: dict[str, tuple[str, str]] = {
     "ground-station": ("ground_station.bench:main", "event-to-plan latency, loss detection"),
     "sim": ("sim_fleet.bench:main", "simulator physics rate, telemetry rate, CPU"),
     "planner": ("ground_station.planner.cli:bench_main", "planner speed and plan quality"),
+    "live-plan": ("ground_station.bench_quality:main", "the live plan against the offline one"),
 }
 
 

@@ -153,9 +153,15 @@ class FleetReply(Message, frozen=True, kw_only=True, tag="fleet"):
 
 
 class PlansReply(Message, frozen=True, kw_only=True, tag="plans"):
-    """Current plans."""
+    """Current plans and the live plan's quality: its objective (seconds:
+    weight-averaged completion + makespan), mission seconds since an
+    improvement was adopted, and its gap to the best plan seen for the same
+    state (a fraction); None where not known yet."""
 
     plans: list[Plan]
+    objective_s: float | None = None
+    improved_ago_s: float | None = None
+    gap_to_best: float | None = None
 
 
 class HistoryReply(Message, frozen=True, kw_only=True, tag="history"):

@@ -166,6 +166,21 @@ def create_app(
         plans = (await client.call(GetPlans(), PlansReply)).plans
         return json(sorted(plans, key=lambda p: p.uav_id))
 
+    @app.get(
+        "/v1/plan/quality",
+        summary="The live plan's objective (s), seconds since an improvement was "
+        "adopted, and its gap to the best plan seen for the state (null: not known yet)",
+    )
+    async def plan_quality() -> Response:
+        reply = await client.call(GetPlans(), PlansReply)
+        return json(
+            {
+                "objective_s": reply.objective_s,
+                "improved_ago_s": reply.improved_ago_s,
+                "gap_to_best": reply.gap_to_best,
+            }
+        )
+
     @app.get("/v1/events", summary="Ground-station events as Server-Sent Events")
     async def events(request: Request, after_seq: int | None = None) -> StreamingResponse:
         return StreamingResponse(

@@ -17,7 +17,13 @@ import msgspec
 from rich.console import Console
 
 from linecrew.client.gateway import Gateway, GatewayError
-from linecrew.client.render import actions_table, fleet_table, plan_tasks, plan_timeline
+from linecrew.client.render import (
+    actions_table,
+    fleet_table,
+    plan_quality,
+    plan_tasks,
+    plan_timeline,
+)
 from linecrew.client.session import NoRunError, Target, resolve
 from linecrew.fault_kinds import add_fault_arguments, fault_from_args
 
@@ -222,6 +228,7 @@ def plan_main(argv: list[str]) -> int:
     try:
         plans = gateway.call("GET", "/v1/plan")
         fleet = [] if args.json else gateway.call("GET", "/v1/fleet")
+        quality = {} if args.json else gateway.call("GET", "/v1/plan/quality")
     except GatewayError as exc:
         print(f"linecrew: {exc}", file=sys.stderr)
         return 1
@@ -233,6 +240,7 @@ def plan_main(argv: list[str]) -> int:
     console = Console()
     console.print(plan_timeline(plans, now, clock))
     console.print(plan_tasks(plans, now))
+    console.print(plan_quality(quality))
     return 0
 
 

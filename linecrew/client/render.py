@@ -91,6 +91,20 @@ def plan_timeline(plans: list[dict[str, Any]], now_s: float, clock: str = "") ->
     return timeline(rows, now_s, max(end, now_s + 1.0), title)
 
 
+def plan_quality(quality: dict[str, Any]) -> str:
+    """One line on the live plan's quality, as ``GET /v1/plan/quality`` gives it."""
+    objective = quality.get("objective_s")
+    if objective is None:
+        return "plan objective: not known yet"
+    parts = [f"plan objective {objective:.1f} s (weight-averaged completion + makespan)"]
+    ago = quality.get("improved_ago_s")
+    parts.append(f"improved {ago:.0f} s ago" if ago is not None else "not improved yet")
+    gap = quality.get("gap_to_best")
+    if gap is not None:
+        parts.append(f"{gap:.1%} above the best plan seen for this state")
+    return "; ".join(parts)
+
+
 def _relative(seconds: float) -> str:
     return f"{seconds:+.0f} s"
 

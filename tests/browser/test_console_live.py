@@ -152,6 +152,8 @@ def test_actions_from_the_forms_are_planned_flown_and_completed(run, new_page, g
     page.locator(f"#gantt .bar.kind-monitor[data-action='{watch}']").first.wait_for()
     assert page.locator("#gantt .gantt-now").count() == 1
     assert page.inner_text("#gantt-epoch").startswith("latest epoch")
+    page.wait_for_function("() => document.getElementById('plan-quality').dataset.objective")
+    assert page.inner_text("#plan-quality").startswith("objective ")
     bar_title = page.locator(f"#gantt .bar[data-action='{watch}'] title").first.text_content()
     assert watch in bar_title and "monitor" in bar_title
 

@@ -1,11 +1,16 @@
 """A mission manager with a real store and planner, and the fake outside
-world it talks to (recorded plans and events, a hand-driven clock)."""
+world it talks to (recorded plans and events, a hand-driven clock).
+
+Requests and reports only trigger the planning worker; ``settle()`` runs the
+pending replans synchronously, so tests drive planning deterministically.
+The helpers here settle after each step."""
 
 from __future__ import annotations
 
 from ground_station.event_log import EventLog
 from ground_station.fleet_monitor import FleetMonitor
 from ground_station.missions import MissionManager
+from ground_station.replan_jobs import ImproveSettings
 from ground_station.replanner import Replanner
 from ground_station.store import Store
 from linecrew.scenarios import load
@@ -25,7 +30,7 @@ ALL = ("uav-1", "uav-2", "uav-3")
 class Harness:
     """Builds the ground station's components around one SQLite file."""
 
-    def __init__(self, db_path: str, now: float = 1000.0) -> None:
+    def __init__(self, db_path: str, now: float = 1000.0, improve: bool = False) -> None:
         self.scenario = load("paper")
         self.now = now
         self.sent: list[Plan] = []
@@ -39,6 +44,7 @@ class Harness:
             monitor=self.monitor,
             events=log,
             send=self.sent.append,
+            improve=ImproveSettings(enabled=improve),
         )
         self.manager = MissionManager(
             scenario=self.scenario,
@@ -47,7 +53,13 @@ class Harness:
             events=log,
             replanner=self.replanner,
             clock=lambda: self.now,
+            improve=improve,
         )
+
+    def settle(self, improve: bool = False) -> None:
+        """Run the replans the triggers so far asked for (and, with
+        ``improve``, the improvement attempts due)."""
+        self.manager.worker.settle(improve=improve)
 
     def telemetry(self, uav_id: str, battery_wh: float | None = None) -> Telemetry:
         """A landed-at-home sample of ``uav_id`` (full battery by default)."""
@@ -70,6 +82,7 @@ class Harness:
             self.monitor.on_token(uav_id, True, self.now)
             self.monitor.on_telemetry(self.telemetry(uav_id), self.now)
         self.manager.on_fleet_changes(self.monitor.check(self.now))
+        self.settle()
 
     def heartbeat(self, *uav_ids: str) -> None:
         """Fresh telemetry from ``uav_ids``."""
@@ -80,6 +93,7 @@ class Harness:
         """Move the clock and run the watchdog."""
         self.now += seconds
         self.manager.on_fleet_changes(self.monitor.check(self.now))
+        self.settle()
 
     def submit(self, name: str, request_id: str | None = None):
         """Submit the paper scenario's scripted action ``name``."""
@@ -87,7 +101,9 @@ class Harness:
         request = SubmitAction(
             request_id=request_id or f"req-{name}", action=scripted.action, action_id=name
         )
-        return self.manager.submit(request)
+        self.manager.submit(request)
+        self.settle()
+        return self.manager.book.record(name)
 
     def latest(self, uav_id: str) -> Plan:
         """The last plan sent to ``uav_id``."""

@@ -28,7 +28,9 @@ from tests.ground_station.harness import ALL, Harness
 
 
 def submit(gs: Harness, action, action_id: str):
-    return gs.manager.submit(SubmitAction(request_id=action_id, action=action, action_id=action_id))
+    gs.manager.submit(SubmitAction(request_id=action_id, action=action, action_id=action_id))
+    gs.settle()
+    return gs.store.action(action_id)
 
 
 def outcome(gs: Harness, uav_id: str, task, result=OutcomeResult.COMPLETED, **extra) -> None:
@@ -43,6 +45,7 @@ def outcome(gs: Harness, uav_id: str, task, result=OutcomeResult.COMPLETED, **ex
             **extra,
         )
     )
+    gs.settle()
 
 
 def pair_monitor(gs: Harness) -> dict[str, list]:
@@ -105,6 +108,7 @@ def test_the_last_copy_of_a_tool_is_reserved_and_given_back_on_cancel(gs):
     assert refused.value.code == "tool_out_of_stock" and refused.value.field == "action.tool"
     assert gs.store.action("second") is None
     gs.manager.cancel(CancelAction(request_id="c", action_id="first"))
+    gs.settle()
     assert submit(gs, wrench, "third").state == ActionState.PLANNED
 
 
@@ -129,6 +133,7 @@ def test_a_drop_with_the_tool_carried_to_the_worker_completes(gs):
     )
     gs.monitor.on_telemetry(carrying, gs.now)
     gs.manager.reports.on_telemetry(carrying)
+    gs.settle()
     drop = next(t for t in gs.replanner.plans["uav-1"].tasks if t.task_id == drop.task_id)
     outcome(gs, "uav-1", drop)
     assert gs.store.action("d").state == ActionState.COMPLETED
@@ -192,6 +197,7 @@ def test_outcomes_heard_before_the_uav_is_back_wait_for_it(tmp_path):
             result=OutcomeResult.COMPLETED,
         )
     )
+    restarted.settle()
     assert restarted.store.action("d").state == ActionState.PLANNED  # held, not lost nor stale
     restarted.bring_up(*ALL)
     assert restarted.store.action("d").state == ActionState.IN_PROGRESS
@@ -229,9 +235,11 @@ def test_an_action_no_uav_can_take_yet_is_retried_as_time_passes(gs):
     assert gs.store.action("later").state == ActionState.ACCEPTED
     replans = gs.replanner.stats.count
     gs.manager.retry_unplaced()  # too soon after the last retry: nothing
+    gs.settle()
     assert gs.replanner.stats.count == replans
     gs.now += 31
     gs.manager.retry_unplaced()
+    gs.settle()
     assert gs.replanner.stats.count == replans + 1
 
 
@@ -245,6 +253,7 @@ def test_an_agent_idle_on_a_plan_that_still_has_work_gets_it_again(gs):
                 uav_id="uav-1", stamp_s=gs.now + dt, state=AgentState.IDLE, epoch=plan.epoch
             )
         )
+        gs.settle()
     resent = [p for p in gs.sent if p.uav_id == "uav-1"]
     assert len(resent) == 1 and resent[0].epoch > plan.epoch
     assert [t.task_id for t in resent[0].tasks][:2] == [t.task_id for t in plan.tasks][:2]
@@ -275,6 +284,7 @@ def test_a_late_outcome_of_an_earlier_task_with_the_same_id_is_stale(gs):
             result=OutcomeResult.COMPLETED,
         )
     )
+    gs.settle()
     assert [t.task_id for t in gs.replanner.plans[uav].tasks] == [t.task_id for t in tasks]
     assert [e for e in gs.events if e.detail == f"stale outcome {home.task_id} completed"]
 
@@ -297,4 +307,5 @@ def test_an_outcome_under_an_older_epoch_still_counts_for_a_task_carried_over(gs
             flown_s=segment.duration_s,
         )
     )
+    gs.settle()
     assert gs.store.action("watch").state == ActionState.COMPLETED

@@ -70,6 +70,7 @@ def test_cancel_removes_the_work_and_is_idempotent(gs):
     gs.submit("inspect-loop")
     owner = gs.sent[-1].uav_id
     record = gs.manager.cancel(CancelAction(request_id="c1", action_id="inspect-loop"))
+    gs.settle()
     assert record.state == ActionState.CANCELLED
     assert not [t for t in gs.latest(owner).tasks if t.action_id == "inspect-loop"]
     assert gs.manager.cancel(CancelAction(request_id="c2", action_id="inspect-loop")) == record
@@ -80,8 +81,10 @@ def test_cancel_removes_the_work_and_is_idempotent(gs):
 def test_modify_changes_priority_and_refuses_finished_actions(gs):
     gs.submit("inspect-loop")
     record = gs.manager.modify(ModifyAction(request_id="m", action_id="inspect-loop", priority=9))
+    gs.settle()
     assert record.action.priority == 9
     gs.manager.cancel(CancelAction(request_id="c", action_id="inspect-loop"))
+    gs.settle()
     with pytest.raises(Exception, match="cancelled"):
         gs.manager.modify(ModifyAction(request_id="m2", action_id="inspect-loop", priority=1))
 
@@ -108,6 +111,7 @@ def test_outcomes_complete_an_inspection_waypoint_by_waypoint(gs):
             waypoints_done=first_half,
         )
     )
+    gs.settle()
     record = gs.store.action("inspect-loop")
     assert record.state == ActionState.IN_PROGRESS and record.waypoints_done == first_half
     plan, task = _inspect_task(gs, "inspect-loop")
@@ -121,6 +125,7 @@ def test_outcomes_complete_an_inspection_waypoint_by_waypoint(gs):
             waypoints_done=[w.index for w in task.waypoints],
         )
     )
+    gs.settle()
     record = gs.store.action("inspect-loop")
     assert record.state == ActionState.COMPLETED and record.progress == 1.0
 
@@ -138,6 +143,7 @@ def test_stale_outcomes_are_recorded_but_change_nothing(gs):
             waypoints_done=list(range(8)),
         )
     )
+    gs.settle()
     assert gs.store.action("inspect-loop").state == ActionState.PLANNED
     assert gs.manager.reports.counters.stale_outcomes == 1
     assert gs.events[-1].kind == EventKind.FAULT
@@ -185,10 +191,13 @@ def test_battery_below_the_plan_replans_once_per_epoch(gs):
     plan, _ = _inspect_task(gs, "inspect-loop")
     landed = gs.telemetry(plan.uav_id, battery_wh=1.0)
     gs.manager.reports.on_telemetry(landed)  # on a pad it draws nothing: not a battery fault
+    gs.settle()
     assert gs.manager.reports.counters.battery_replans == 0
     low = msgspec.structs.replace(landed, flight_state=FlightState.FLYING)
     gs.manager.reports.on_telemetry(low)
+    gs.settle()
     gs.manager.reports.on_telemetry(low)
+    gs.settle()
     assert gs.manager.reports.counters.battery_replans == 1
 
 
@@ -216,6 +225,7 @@ def test_a_status_naming_a_finished_action_does_not_break_replanning(gs):
         )
     )
     gs.manager.cancel(CancelAction(request_id="c", action_id="monitor-w2"))
+    gs.settle()
     refused = [e for e in gs.events if e.kind == EventKind.FAULT and "refused" in e.detail]
     assert refused == []
     assert gs.store.action("monitor-w2").state == ActionState.CANCELLED

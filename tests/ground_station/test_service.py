@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import sys
 import time
+from collections.abc import Iterable
 
 import pytest
 
@@ -17,6 +18,7 @@ from proto import (
     ActionReply,
     ActionState,
     EventKind,
+    GetAction,
     GetHistory,
     GetMetrics,
     HistoryReply,
@@ -71,6 +73,16 @@ def gs(router, client, tmp_path):
         yield p
 
 
+def lost_uavs(client: Bus) -> list[str]:
+    return [e.uav_id for e in history(client).events if e.kind == EventKind.UAV_LOST]
+
+
+def settled(client: Bus) -> bool:
+    """Whether the gs's plan is final for now (improvement included)."""
+    metrics = client.query(KEYS.rpc("metrics"), GetMetrics(), MetricsReply, 5.0)
+    return metrics.values.get("planner_settled") == 1.0
+
+
 @pytest.fixture
 def agents(bus_config, gs):
     fleet = {u: LightAgent(bus_config, SCENARIO, u) for u in UAVS}
@@ -92,6 +104,18 @@ def history(client: Bus) -> HistoryReply:
     return client.query(KEYS.rpc("history"), GetHistory(limit=1000), HistoryReply, 5.0)
 
 
+def waypoints_of(agents: Iterable[LightAgent], action_id: str) -> set[int]:
+    """The waypoint indices of inspection ``action_id`` in the agents' latest plans."""
+    return {
+        w.index
+        for agent in agents
+        if (plan := agent.latest())
+        for t in plan.tasks
+        if isinstance(t, InspectTask) and t.action_id == action_id
+        for w in t.waypoints
+    }
+
+
 def owner_of(agents: dict[str, LightAgent], action_id: str) -> LightAgent | None:
     for agent in agents.values():
         plan = agent.latest()
@@ -102,7 +126,17 @@ def owner_of(agents: dict[str, LightAgent], action_id: str) -> LightAgent | None
 
 def test_a_new_action_reaches_the_capable_agent(client, agents):
     reply = submit(client, "deliver-wrench")
-    assert reply.record.state == ActionState.PLANNED
+    assert reply.record.state == ActionState.ACCEPTED  # durable; the plan follows
+    wait_until(
+        lambda: (
+            client.query(
+                KEYS.rpc("get_action"), GetAction(action_id="deliver-wrench"), ActionReply, 5.0
+            ).record.state
+            == ActionState.PLANNED
+        ),
+        10,
+        "the action planned",
+    )
     uav1 = agents["uav-1"]
     wait_until(
         lambda: uav1.latest().tasks and isinstance(uav1.latest().tasks[0], PickTask),
@@ -115,6 +149,7 @@ def test_a_new_action_reaches_the_capable_agent(client, agents):
 def test_brief_drop_out_changes_nothing_and_a_long_one_moves_the_work(client, agents):
     submit(client, "inspect-loop")
     wait_until(lambda: owner_of(agents, "inspect-loop"), 10, "inspection planned")
+    wait_until(lambda: settled(client), 30, "the background improvement done")
     victim = owner_of(agents, "inspect-loop")
     victim.go_silent()
     time.sleep(LINK_TIMEOUT_S / 4)  # well inside the grace: must change nothing
@@ -122,11 +157,12 @@ def test_brief_drop_out_changes_nothing_and_a_long_one_moves_the_work(client, ag
     events = history(client).events
     assert not [e for e in events if e.kind == EventKind.UAV_LOST]
     victim.go_silent()
-    wait_until(lambda: owner_of(agents, "inspect-loop") not in (None, victim), 15, "work moved")
-    lost = [e for e in history(client).events if e.kind == EventKind.UAV_LOST]
-    assert [e.uav_id for e in lost] == [victim.uav_id]
+    share = waypoints_of([victim], "inspect-loop")
+    others = [a for a in agents.values() if a is not victim]
+    wait_until(lambda: share <= waypoints_of(others, "inspect-loop"), 15, "work moved")
+    assert lost_uavs(client) == [victim.uav_id]
     victim.speak_again()
-    moved_epoch = owner_of(agents, "inspect-loop").latest().epoch
+    moved_epoch = max(a.latest().epoch for a in others)
     wait_until(lambda: victim.latest().epoch > moved_epoch, 15, "a fresh plan for the returner")
 
 

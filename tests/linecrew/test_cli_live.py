@@ -119,6 +119,9 @@ def test_plan_prints_mission_times_from_now_on_the_sped_up_clock(run, gateway):
     start, end = (int(v) for v in re.findall(r"([+-]\d+) s", row)[:2])
     assert abs(end - (task["end_s"] - now)) < 30, (row, task["end_s"] - now)
     assert abs(start - (task["start_s"] - now)) < 30, (row, task["start_s"] - now)
+    quality = gateway.call("GET", "/v1/plan/quality")
+    assert quality["objective_s"] > 0
+    assert re.search(r"plan objective \d+\.\d s", done.stdout), done.stdout
 
 
 def test_events_into_head_ends_quietly(run, gateway):

@@ -83,6 +83,9 @@ def test_fleet_plan_metrics_and_openapi(gateway):
     assert sorted(u["uav_id"] for u in fleet) == ["uav-1", "uav-2", "uav-3"]
     assert all(u["state"] == "lost" for u in fleet)  # no agents in this test
     assert gateway.get("/v1/plan").status_code == 200
+    quality = gateway.get("/v1/plan/quality").json()
+    assert set(quality) == {"objective_s", "improved_ago_s", "gap_to_best"}
+    assert quality["improved_ago_s"] is None  # nothing improved with no UAV up
     metrics = gateway.get("/metrics").text
     assert "linecrew_ground_station_up 1" in metrics and "linecrew_gs_replans" in metrics
     spec = gateway.get("/openapi.json").json()

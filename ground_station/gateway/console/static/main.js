@@ -84,7 +84,20 @@ async function quietly(fn) {
 }
 
 const refreshFleet = () => quietly(async () => setFleet(await api("GET", "v1/fleet")));
-const refreshPlans = () => quietly(async () => setPlans(await api("GET", "v1/plan")));
+const refreshPlans = () =>
+  quietly(async () => {
+    setPlans(await api("GET", "v1/plan"));
+    setQuality(await api("GET", "v1/plan/quality"));
+  });
+
+/** The live plan's objective and improvement age beside the epoch. */
+function setQuality(q) {
+  const el = document.getElementById("plan-quality");
+  if (!el || q.objective_s == null) return;
+  const ago = q.improved_ago_s == null ? "not improved yet" : `improved ${Math.round(q.improved_ago_s)} s ago`;
+  el.textContent = `objective ${q.objective_s.toFixed(1)} s, ${ago}`;
+  el.dataset.objective = String(q.objective_s);
+}
 const refreshActions = () => quietly(async () => setActions(await api("GET", "v1/actions")));
 const plansSoon = later(refreshPlans, 100);
 const actionsSoon = later(refreshActions, 100);

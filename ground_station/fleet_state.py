@@ -1,0 +1,78 @@
+"""The fleet's state as the planner needs it, read from the watchdog's latest
+reports and the plans held: where each UAV is, its energy, whether it can
+take work, and the action it is in the middle of."""
+
+from __future__ import annotations
+
+import math
+
+from ground_station.fleet_monitor import FleetMonitor
+from ground_station.planning import UavNow
+from proto.plan import DeliverTask, GoHomeTask, MonitorTask, Plan, Task
+from proto.scenario import Scenario
+from proto.telemetry import FlightState
+
+ON_PAD_M = 1.0
+"""A landed UAV this close (horizontally) to a station is on its pad."""
+
+AIRBORNE = frozenset({FlightState.FLYING, FlightState.TAKING_OFF, FlightState.LANDING})
+
+
+def uavs_now(
+    scenario: Scenario, monitor: FleetMonitor, plans: dict[str, Plan], in_force: set[str]
+) -> list[UavNow]:
+    """Every UAV of the fleet as of its latest telemetry (at home, full, if none)."""
+    site, fleet = scenario.site, scenario.fleet
+    uavs = []
+    for spec in fleet.uavs:
+        telemetry = monitor.telemetry(spec.id)
+        home = site.station(spec.home_station)
+        capacity = fleet.type_of(spec.id).battery_wh
+        uavs.append(
+            UavNow(
+                uav_id=spec.id,
+                position=telemetry.position if telemetry else home.position,
+                energy_wh=min(capacity, telemetry.battery_wh) if telemetry else capacity,
+                available=monitor.available(spec.id),
+                airborne=bool(telemetry and telemetry.flight_state in AIRBORNE),
+                tool=telemetry.tool if telemetry else None,
+                running_action=running_action(monitor, plans.get(spec.id), in_force),
+            )
+        )
+    return uavs
+
+
+def running_action(monitor: FleetMonitor, plan: Plan | None, in_force: set[str]) -> str | None:
+    """The monitoring action in force the UAV of ``plan`` is executing, or the
+    delivery whose tool its telemetry says it holds, if any."""
+    if plan is None:
+        return None
+    status, telemetry = monitor.status(plan.uav_id), monitor.telemetry(plan.uav_id)
+    if status is None or status.task_id is None:
+        return None
+    for task in plan.tasks:
+        if task.task_id != status.task_id or task.action_id not in in_force:
+            continue
+        holds_tool = telemetry is not None and telemetry.tool == getattr(task, "tool", None)
+        if isinstance(task, MonitorTask) or (isinstance(task, DeliverTask) and holds_tool):
+            return task.action_id
+    return None
+
+
+def drop_done_home(
+    scenario: Scenario, monitor: FleetMonitor, uav_id: str, tasks: list[Task]
+) -> list[Task]:
+    """A plan that only sends a UAV to the pad it already sits on asks
+    nothing: it is empty (else the agent would "complete" it at once, over
+    and over)."""
+    telemetry = monitor.telemetry(uav_id)
+    if len(tasks) != 1 or not isinstance(tasks[0], GoHomeTask) or telemetry is None:
+        return tasks
+    station = scenario.site.station(tasks[0].station_id)
+    p = telemetry.position
+    on_pad = (
+        telemetry.flight_state == FlightState.LANDED
+        and station is not None
+        and math.hypot(p.x_m - station.position.x_m, p.y_m - station.position.y_m) <= ON_PAD_M
+    )
+    return [] if on_pad else tasks
