@@ -44,7 +44,11 @@ waiting for a UAV (then a UAV back on its pad or recharged may take it)."""
 IDLE_MISMATCH_S = 5.0
 """Mission seconds an agent may report idle while its plan has tasks."""
 MAX_TASK_FAILURES = 3
-"""Failed attempts at one task (each resent after the first) before its action fails."""
+"""Failed attempts at one task that the ground station judged (a drop it could
+not confirm; each resent after the first) before its action fails."""
+MAX_RETRYABLE_FAILURES = 10
+"""Failures for a passing reason at one task before its action fails anyway
+(a guard against a reason that never passes)."""
 EMERGENCY_PREFIX = "emergency:"
 """How an agent's reason for tasks dropped by its emergency protocol begins."""
 ROUND_SLACK_S = 5.0
@@ -119,7 +123,8 @@ class AgentReports:
                 detail=f"stale outcome {outcome.task_id} {outcome.result}",
             )
             return
-        if isinstance(task, DeliverTask) and outcome.result == OutcomeResult.COMPLETED:
+        judged = isinstance(task, DeliverTask) and outcome.result == OutcomeResult.COMPLETED
+        if judged:
             outcome = self._confirm_drop(outcome, task)
         if task.action_id is not None:
             record = self.book.store.action(task.action_id)
@@ -131,7 +136,7 @@ class AgentReports:
         if isinstance(task, MonitorTask) and outcome.result == OutcomeResult.COMPLETED:
             self._announce_handover(outcome.uav_id, task)
         self.replanner.finished(outcome.uav_id, outcome.task_id)
-        if outcome.result == OutcomeResult.FAILED and self._gave_up(task, outcome):
+        if outcome.result == OutcomeResult.FAILED and self._gave_up(task, outcome, judged):
             return
         if outcome.result != OutcomeResult.COMPLETED:
             # the agent dropped the task: if the replan gives it back unchanged
@@ -150,18 +155,29 @@ class AgentReports:
         for outcome in self._held.pop(uav_id, []):
             self.on_outcome(outcome)
 
-    def _gave_up(self, task: Task, outcome: TaskOutcome) -> bool:
-        """Count a failed attempt at ``task``; after ``MAX_TASK_FAILURES`` the
-        action fails with the agent's reason (and the work is replanned). A
-        task abandoned by the agent's emergency protocol was not attempted."""
-        if outcome.reason.startswith(EMERGENCY_PREFIX):
+    def _gave_up(self, task: Task, outcome: TaskOutcome, judged: bool) -> bool:
+        """Whether the failure of ``task`` fails its action (then the work is
+        replanned). A permanent failure from the agent (which already retried
+        on board) does at once, with its reason and code; a retryable one (a
+        passing reason, an emergency) only after ``MAX_RETRYABLE_FAILURES``;
+        one the ground station ``judged`` (a drop it could not confirm) after
+        ``MAX_TASK_FAILURES``."""
+        if task.action_id is None or outcome.reason.startswith(EMERGENCY_PREFIX):
             return False
-        self._failures[task.task_id] = self._failures.get(task.task_id, 0) + 1
-        if self._failures[task.task_id] < MAX_TASK_FAILURES or task.action_id is None:
+        self._failures[task.task_id] = count = self._failures.get(task.task_id, 0) + 1
+        if judged:
+            limit = MAX_TASK_FAILURES
+        elif outcome.retryable:
+            limit = MAX_RETRYABLE_FAILURES
+        else:
+            limit = 1
+        if count < limit:
             return False
         record = self.book.store.action(task.action_id)
         if record is not None and record.state not in TERMINAL:
-            reason = f"{task.task_id} failed {MAX_TASK_FAILURES} times: {outcome.reason}"
+            code = f" [{outcome.reason_code}]" if outcome.reason_code else ""
+            times = f" {count} times" if count > 1 else ""
+            reason = f"{task.task_id} failed{times}{code}: {outcome.reason}"
             self.book.transition(record, ActionEvent.IMPOSSIBLE, reason)
         self.replan(f"{task.action_id} given up")
         return True

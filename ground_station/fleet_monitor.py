@@ -42,6 +42,7 @@ class Change(enum.StrEnum):
     BACK = "back"
     CRASHED = "crashed"  # telemetry says crashed (or disarmed in the air): lost at once
     FAILED = "failed"  # the agent reports itself failed (e.g. no autopilot): lost at once
+    NOT_READY = "not_ready"  # on its pad, the autopilot cannot arm yet: work goes elsewhere
 
 
 @dataclasses.dataclass
@@ -57,11 +58,13 @@ class _Uav:
 
 
 def _down(uav: _Uav) -> Change | None:
-    """Whether the UAV's own reports say it cannot fly any more."""
+    """Whether the UAV's own reports say it cannot fly (any more, or for now)."""
     if uav.telemetry is not None and uav.telemetry.flight_state == FlightState.CRASHED:
         return Change.CRASHED
     if uav.status is not None and uav.status.state == AgentState.FAILED:
         return Change.FAILED
+    if uav.status is not None and uav.status.state == AgentState.NOT_READY:
+        return Change.NOT_READY
     return None
 
 
@@ -92,11 +95,14 @@ class FleetMonitor:
             uav.telemetry = telemetry
             uav.heard_s = now_s
 
-    def on_status(self, status: AgentStatus) -> None:
-        """An agent status arrived."""
+    def on_status(self, status: AgentStatus, now_s: float | None = None) -> None:
+        """An agent status arrived (at ``now_s`` of the receiver's clock: the
+        agent is heard, even while it has no position to send telemetry of)."""
         uav = self._uavs.get(status.uav_id)
         if uav is not None:
             uav.status = status
+            if now_s is not None:
+                uav.heard_s = now_s
 
     def silence_s(self, uav_id: str, now_s: float) -> float:
         """How long ``uav_id`` has been silent (``inf`` if never heard)."""
@@ -119,7 +125,8 @@ class FleetMonitor:
                 # reported failed until its autopilot answered): back, so that
                 # it gets a fresh plan instead of flying the one it resynced
                 changes.append((uav_id, Change.BACK))
-            uav.down = down
+            # a lost UAV's state is said once it is back (the next check)
+            uav.down = None if uav.lost else down
             silent = self.silence_s(uav_id, now_s) >= self.link_timeout_s
             if silent and not uav.lost:
                 uav.lost, uav.lost_s = True, now_s

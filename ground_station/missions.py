@@ -24,6 +24,7 @@ from ground_station.agent_reports import AgentReports
 from ground_station.event_log import EventLog
 from ground_station.fleet_monitor import Change, FleetMonitor
 from ground_station.lifecycle import TERMINAL, TRANSITIONS, ActionEvent
+from ground_station.monitor_bearings import as_requested, with_bearing
 from ground_station.plan_worker import PlanWorker
 from ground_station.replan_jobs import Computed, Job, ReplanOutcome
 from ground_station.replanner import Replanner
@@ -31,7 +32,7 @@ from ground_station.store import Store
 from ground_station.validation import validate
 from proto.errors import RequestError
 from proto.events import EventKind
-from proto.mission import ActionRecord, ActionState, DeliverAction
+from proto.mission import ActionRecord, ActionState, DeliverAction, MonitorAction
 from proto.plan import (
     MonitorTask,
     Plan,
@@ -63,12 +64,15 @@ FLEET_EVENTS = {
     Change.BACK: EventKind.UAV_BACK,
     Change.CRASHED: EventKind.UAV_CRASHED,
     Change.FAILED: EventKind.UAV_LOST,
+    Change.NOT_READY: EventKind.UAV_STATE,
 }
 FLEET_TEXT = {
     Change.LOST: "silent past the link timeout; its work goes to others",
     Change.BACK: "heard again; it gets a fresh plan",
     Change.CRASHED: "telemetry says crashed; its work goes to others at once",
     Change.FAILED: "its agent reports failed; its work goes to others at once",
+    Change.NOT_READY: "not ready (its autopilot cannot arm yet); its work goes to others "
+    "until it is",
 }
 
 
@@ -156,20 +160,26 @@ class MissionManager:
     def submit(self, request: SubmitAction) -> ActionRecord:
         """Accept an action: validated, stored durably, then planned (later)."""
         existing = self.store.action_by_request(request.request_id)
+        action = request.action
         if existing is not None:
-            if existing.action != request.action:
+            stored = existing.action
+            if isinstance(stored, MonitorAction) and isinstance(action, MonitorAction):
+                stored = as_requested(stored, action)
+            if stored != action:
                 raise Conflict("request_id already used for another action", field="request_id")
             return existing
-        validate(request.action, self.scenario.site, self.scenario.fleet)
-        if isinstance(request.action, DeliverAction):
-            inventory.reserve(self.scenario.site, self.store.actions(), request.action)
+        validate(action, self.scenario.site, self.scenario.fleet)
+        if isinstance(action, DeliverAction):
+            inventory.reserve(self.scenario.site, self.store.actions(), action)
+        if isinstance(action, MonitorAction):
+            action = with_bearing(action, self.in_force())
         action_id = request.action_id or f"act-{self.store.next_counter('action'):05d}"
         if self.store.action(action_id) is not None:
             raise Conflict(f"action id {action_id!r} exists", field="action_id")
         now = self.clock()
         record = ActionRecord(
             action_id=action_id,
-            action=request.action,
+            action=action,
             state=ActionState.ACCEPTED,
             created_s=now,
             updated_s=now,
@@ -177,7 +187,7 @@ class MissionManager:
         )
         self.store.insert_action(record, now)
         self.events.emit(
-            EventKind.ACTION_ACCEPTED, action_id=action_id, detail=type(request.action).__name__
+            EventKind.ACTION_ACCEPTED, action_id=action_id, detail=type(action).__name__
         )
         self.request_replan(f"action {action_id} added")
         return self.book.record(action_id)
@@ -196,6 +206,9 @@ class MissionManager:
         if isinstance(action, DeliverAction):
             others = [r for r in self.store.actions() if r.action_id != record.action_id]
             inventory.reserve(self.scenario.site, others, action)
+        if isinstance(action, MonitorAction) and action.bearing_deg is None:
+            assert isinstance(record.action, MonitorAction)  # same kind, checked above
+            action = msgspec.structs.replace(action, bearing_deg=record.action.bearing_deg)
         self.book.save(msgspec.structs.replace(record, action=action), record.state, "modified")
         self.events.emit(EventKind.ACTION_CHANGED, action_id=record.action_id)
         self.request_replan(f"action {record.action_id} changed")
@@ -214,9 +227,14 @@ class MissionManager:
     # -- agents ----------------------------------------------------------------
 
     def on_fleet_changes(self, changes: list[tuple[str, Change]]) -> None:
-        """A UAV was lost (after the grace), crashed, or came back: replan."""
+        """A UAV was lost (after the grace), crashed, failed, is not ready, or
+        came back: replan."""
         for uav_id, change in changes:
-            self.events.emit(FLEET_EVENTS[change], uav_id=uav_id, detail=FLEET_TEXT[change])
+            detail = FLEET_TEXT[change]
+            status = self.monitor.status(uav_id)
+            if change == Change.NOT_READY and status is not None and status.reason:
+                detail = f"{status.reason}; its work goes to others until it is ready"
+            self.events.emit(FLEET_EVENTS[change], uav_id=uav_id, detail=detail)
             if change == Change.BACK:
                 self.replanner.resend(uav_id)
             else:

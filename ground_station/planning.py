@@ -163,6 +163,7 @@ def _action(
                 k=action.uavs,
                 standoff_m=action.standoff_m,
                 height_m=safety.monitor_height_m,
+                bearing_deg=action.bearing_deg or 0.0,
                 duration_s=max(1.0, action.duration_s - record.monitored_s),
                 start_s=_promised(monitor_starts.get(record.action_id), now_s),
             )
@@ -297,6 +298,7 @@ def _simple_task(
                 slots=action.uavs,
                 standoff_m=action.standoff_m,
                 height_m=safety.monitor_height_m,
+                bearing_deg=action.bearing_deg or 0.0,
                 duration_s=max(0.001, step.end_s - step.arrive_s),
                 **times,
             )

@@ -127,7 +127,7 @@ class GroundStation:
             self.manager.reports.on_telemetry(telemetry)
 
     def _on_status(self, _key: str, status: AgentStatus) -> None:
-        self.monitor.on_status(status)
+        self.monitor.on_status(status, time.monotonic())
         if self.monitor.known(status.uav_id):
             self.manager.reports.on_status(status)
 

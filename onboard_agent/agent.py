@@ -70,6 +70,7 @@ class Agent:
         self.root = idioms.main_tree(self.ctx)
         self.tree = py_trees.trees.BehaviourTree(self.root)
         self.emergency = Emergency(self.ctx)
+        self._autopilot_seen = False  # a heartbeat has been heard since the start
         self._last_status: tuple[object, ...] = ()
 
     @property
@@ -112,7 +113,10 @@ class Agent:
     def state(self) -> tuple[AgentState, str]:
         """The agent's state as operators see it, and why."""
         ctx = self.ctx
+        self._autopilot_seen |= ctx.vehicle.link_ok
         if not ctx.vehicle.link_ok:
+            if not self._autopilot_seen and ctx.config.not_ready_state:
+                return AgentState.NOT_READY, "not ready: waiting for the autopilot's heartbeat"
             return AgentState.FAILED, "no autopilot heartbeat"
         if ctx.emergency:
             return AgentState.EMERGENCY, ctx.emergency

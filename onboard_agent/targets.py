@@ -61,17 +61,18 @@ def _safe(ctx: Context, point: Point) -> Point:
 
 def monitor_slot(ctx: Context) -> Point | None:
     """Slot ``slot`` of ``slots`` on a circle of ``standoff_m`` around the
-    worker, ``height_m`` above them (never at a person's own height). Before
-    the segment's window begins (a relief that arrived early, while the UAV
-    it relieves still holds the slot) the point lies ``handover_hold_m``
-    farther out on the same bearing, clear of that UAV."""
+    worker (counted from the bearing ``bearing_deg``), ``height_m`` above
+    them (never at a person's own height). Before the segment's window
+    begins (a relief that arrived early, while the UAV it relieves still
+    holds the slot) the point lies ``handover_hold_m`` farther out on the
+    same bearing, clear of that UAV."""
     task = ctx.mission.head
     if not isinstance(task, MonitorTask):
         return None
     worker = ctx.surroundings.worker_position(task.worker_id)
     if worker is None:
         return None
-    angle = 2 * math.pi * task.slot / task.slots
+    angle = math.radians(task.bearing_deg) + 2 * math.pi * task.slot / task.slots
     early = task.end_s > 0 and ctx.wall() < task.end_s - task.duration_s
     radius = task.standoff_m + (ctx.config.handover_hold_m if early else 0.0)
     slot = Point(

@@ -17,6 +17,8 @@ NonNegative = Annotated[float, msgspec.Meta(ge=0.0)]
 Positive = Annotated[float, msgspec.Meta(gt=0.0)]
 Count = Annotated[int, msgspec.Meta(ge=0)]
 PositiveCount = Annotated[int, msgspec.Meta(ge=1)]
+Bearing = Annotated[float, msgspec.Meta(ge=0.0, lt=360.0)]
+"""Degrees counter-clockwise from the site's +x axis (east), in [0, 360)."""
 ID_PATTERN = r"^[A-Za-z0-9._-]{1,64}$"
 """An id is one key-expression chunk: safe in every key of :mod:`proto.keys`."""
 

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import enum
 
-from proto.base import Fraction, Id, NonNegative, Positive, PositiveCount, Record
+from proto.base import Bearing, Fraction, Id, NonNegative, Positive, PositiveCount, Record
 from proto.geo import Point
 
 
@@ -33,12 +33,19 @@ class InspectAction(ActionBase, frozen=True, kw_only=True, tag="inspect"):
 
 
 class MonitorAction(ActionBase, frozen=True, kw_only=True, tag="monitor"):
-    """Watch ``worker_id`` with ``uavs`` UAVs at ``standoff_m`` for ``duration_s``."""
+    """Watch ``worker_id`` with ``uavs`` UAVs at ``standoff_m`` for ``duration_s``.
+
+    ``bearing_deg`` is the bearing of slot 0 in degrees, counter-clockwise
+    from the site's +x axis (east); the other slots follow at 360/uavs
+    apart. Left out, the ground station picks the bearing farthest from the
+    slots of the worker's other monitoring actions in force, so that two of
+    them never send UAVs to one point; the stored action holds the choice."""
 
     worker_id: Id
     uavs: PositiveCount = 1
     standoff_m: Positive = 5.0
     duration_s: Positive
+    bearing_deg: Bearing | None = None
 
 
 class DeliverAction(ActionBase, frozen=True, kw_only=True, tag="deliver"):

@@ -39,7 +39,8 @@ class InspectTask(TaskBase, frozen=True, kw_only=True, tag="inspect"):
 
 class MonitorTask(TaskBase, frozen=True, kw_only=True, tag="monitor"):
     """Hold slot ``slot`` of ``slots`` around the worker (``standoff_m``
-    away horizontally, ``height_m`` above them), following them, for
+    away horizontally, ``height_m`` above them, at bearing ``bearing_deg``
+    + 360 * slot / slots degrees from +x), following them, for
     ``duration_s``."""
 
     worker_id: Id
@@ -48,6 +49,7 @@ class MonitorTask(TaskBase, frozen=True, kw_only=True, tag="monitor"):
     standoff_m: Positive
     duration_s: Positive
     height_m: NonNegative = 3.0
+    bearing_deg: float = 0.0
 
 
 class PickTask(TaskBase, frozen=True, kw_only=True, tag="pick"):

@@ -108,7 +108,8 @@ class MonitorAction(msgspec.Struct, frozen=True, kw_only=True, tag="monitor", ta
     """Watch a worker with ``k`` UAVs starting together, for ``duration_s``.
 
     Slot ``s`` sits ``standoff_m`` from the worker horizontally at bearing
-    2*pi*s/k, ``height_m`` above them (never at a person's own height).
+    ``bearing_deg`` + 360*s/k degrees, ``height_m`` above them (never at a
+    person's own height).
     """
 
     id: str
@@ -118,6 +119,7 @@ class MonitorAction(msgspec.Struct, frozen=True, kw_only=True, tag="monitor", ta
     k: int = 1
     standoff_m: float = 5.0
     height_m: float = 3.0
+    bearing_deg: float = 0.0
     duration_s: float
     start_s: float | None = None
     """A synchronised start already promised to the UAVs: kept whenever it

@@ -12,7 +12,7 @@ at their start time; the UAV that left recharges in its own route.
 from __future__ import annotations
 
 import heapq
-from math import cos, dist, pi, sin
+from math import cos, dist, pi, radians, sin
 
 from ground_station.planner import costs
 from ground_station.planner.energy import EPS_S
@@ -40,9 +40,10 @@ RANDOM_T0 = 2
 
 
 def slot_position(a: MonitorAction, slot: int) -> Vec3:
-    """Stand-off position of ``slot``: bearing 2*pi*slot/k, ``height_m`` above the worker."""
+    """Stand-off position of ``slot``: bearing ``bearing_deg`` + 360*slot/k
+    degrees, ``height_m`` above the worker."""
     x, y, z = a.worker_m
-    ang = 2 * pi * slot / a.k
+    ang = radians(a.bearing_deg) + 2 * pi * slot / a.k
     return (x + a.standoff_m * cos(ang), y + a.standoff_m * sin(ang), z + a.height_m)
 
 

@@ -132,6 +132,12 @@ def submit_main(argv: list[str]) -> int:
     monitor.add_argument("--uavs", type=int, default=1)
     monitor.add_argument("--duration", type=float, required=True, help="seconds")
     monitor.add_argument("--standoff", type=float, default=5.0, help="metres")
+    monitor.add_argument(
+        "--bearing",
+        type=float,
+        help="degrees from +x (east) of slot 0 (default: the ground station picks one clear "
+        "of the worker's other monitors)",
+    )
     deliver = kinds.add_parser("deliver", help="deliver a tool to a worker")
     deliver.add_argument("tool")
     deliver.add_argument("--from", dest="station", required=True, help="tool station id")
@@ -148,6 +154,8 @@ def submit_main(argv: list[str]) -> int:
                 "duration_s": args.duration,
                 "standoff_m": args.standoff,
             }
+            if args.bearing is not None:
+                body["bearing_deg"] = args.bearing
         case "deliver":
             body |= {"tool": args.tool, "tool_station_id": args.station, "worker_id": args.worker}
     if args.request_id:

@@ -46,6 +46,7 @@ class RunOptions:
     secure: bool = False  # mutual TLS and access control (``secure``)
     session_file: pathlib.Path | None = None  # default: $LINECREW_SESSION or .linecrew/
     register: bool = True  # list the run in the session file while it is up
+    warmup_s: float | None = None  # the simulated autopilots' GPS/EKF warm-up (mission s)
 
 
 class LocalRun:
@@ -155,6 +156,7 @@ class LocalRun:
             str(scenario_file),
             "--base-port",
             str(base_port),
+            *(["--warmup-s", str(opts.warmup_s)] if opts.warmup_s is not None else []),
         )
         sup.wait_ready(sim, lambda: self._alive(Role.SIM, "sim"), wait)
 

@@ -5,6 +5,8 @@ refused, a UAV killed mid-monitor replaced. Every process is real; x10."""
 
 from __future__ import annotations
 
+import math
+
 import msgspec
 import pytest
 
@@ -113,3 +115,44 @@ def test_a_uav_killed_mid_monitor_is_declared_lost_and_another_takes_the_slot(tr
     after = [s for s in truth.samples if s.sim_s > killed_at]
     others = set().union(*(truth.watching(s, W2, 4.0, SAFETY.monitor_height_m) for s in after))
     assert others - {victim}, "another UAV took the slot after the kill"
+
+
+def test_work_asked_while_the_autopilots_warm_up_waits_for_them_then_flies(tmp_path):
+    """Agents report not ready (not failed) while their autopilots warm up;
+    the ground station gives them no work until they are ready, then they
+    fly it: no vehicle arms before the warm-up ends, nothing fails."""
+    warmup_s = 200.0  # 20 s of wall time at x10: well past the start-up
+    options = RunOptions(speedup=SPEEDUP, run_dir=tmp_path / "run", warmup_s=warmup_s)
+    with LocalRun(PAPER, options) as run:
+        truth = TruthLog(run)
+        assert truth.sample().sim_time_s < warmup_s
+        point = {"position": {"x_m": -5, "y_m": 10, "z_m": 8}}
+        action_id = truth.submit({"type": "inspect", "waypoints": [point]})["action_id"]
+        truth.until("the inspection done", lambda: truth.finished(action_id), 240)
+        assert truth.action(action_id)["state"] == "completed"
+        armed = [s.sim_s for s in truth.samples if any(v.armed for v in s.state.vehicles)]
+        assert armed and min(armed) >= warmup_s
+        kinds = [(e.kind, e.uav_id) for e in truth.events()]
+        for uav in (u.id for u in PAPER.fleet.uavs):
+            assert (EventKind.UAV_STATE, uav) in kinds  # said not ready, not lost or failed
+            assert (EventKind.UAV_LOST, uav) not in kinds
+            not_ready = kinds.index((EventKind.UAV_STATE, uav))
+            assert (EventKind.UAV_BACK, uav) in kinds[not_ready:]  # ready: it got work again
+
+
+def test_two_monitors_of_one_worker_are_flown_on_opposite_sides(truth):
+    """Two k = 1 monitoring actions of W2 at once: the simulator sees both
+    UAVs on the ring, never at one point (each action has its own bearing)."""
+    first = truth.submit(monitor("W2", 1, 90))["action_id"]
+    second = truth.submit(monitor("W2", 1, 90))["action_id"]
+    truth.until("both monitors end", lambda: truth.finished(first, second), 150)
+    assert truth.action(first)["state"] == truth.action(second)["state"] == "completed"
+    together = []
+    for sample in truth.samples:
+        on_ring = truth.watching(sample, W2, 4.0, SAFETY.monitor_height_m)
+        if len(on_ring) == 2:
+            a, b = (v.position for v in sample.state.vehicles if v.uav_id in on_ring)
+            together.append(math.dist((a.x_m, a.y_m, a.z_m), (b.x_m, b.y_m, b.z_m)))
+    assert len(together) > 20, "the two were hardly on the ring together"
+    assert min(together) > 6.0  # opposite sides of a 4 m ring: 8 m apart
+    assert not truth.violations(*UNSAFE)

@@ -122,11 +122,15 @@ def test_an_agent_that_reported_failed_and_recovers_is_back():
     assert monitor.check(2.5) == []
 
 
-def test_an_agent_not_ready_yet_is_present_but_takes_no_work():
+def test_an_agent_not_ready_takes_no_work_until_it_is_ready():
     monitor = FleetMonitor(["u1"], 5.0)
     present(monitor, "u1", 0.0)
     monitor.check(0.0)
     monitor.on_status(AgentStatus(uav_id="u1", stamp_s=0, state=AgentState.NOT_READY))
     assert monitor.state("u1") == UavOpState.NOT_READY
     assert not monitor.available("u1")
-    assert monitor.check(0.5) == []  # neither lost nor failed
+    assert monitor.check(0.5) == [("u1", Change.NOT_READY)]  # its work goes elsewhere
+    assert monitor.check(1.0) == []  # said once
+    monitor.on_status(AgentStatus(uav_id="u1", stamp_s=1, state=AgentState.IDLE))
+    assert monitor.check(1.5) == [("u1", Change.BACK)]  # ready: it gets work again
+    assert monitor.available("u1")

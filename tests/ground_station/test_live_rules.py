@@ -7,6 +7,7 @@ from __future__ import annotations
 import msgspec
 import pytest
 
+from ground_station.agent_reports import MAX_RETRYABLE_FAILURES
 from ground_station.inventory import OutOfStock
 from proto import (
     ActionState,
@@ -157,25 +158,60 @@ def test_a_failed_task_given_back_unchanged_is_sent_again_with_a_new_epoch(gs):
     pick = gs.replanner.plans["uav-1"].tasks[0]
     epoch = gs.replanner.plans["uav-1"].epoch
     gs.sent.clear()
-    outcome(gs, "uav-1", pick, OutcomeResult.FAILED, reason="arming refused: GPS 1: Bad fix")
+    outcome(
+        gs,
+        "uav-1",
+        pick,
+        OutcomeResult.FAILED,
+        reason="arming refused: GPS 1: Bad fix",
+        retryable=True,
+        reason_code="arm_refused",
+    )
     resent = [p for p in gs.sent if p.uav_id == "uav-1"]
     assert resent and resent[-1].epoch > epoch
     assert resent[-1].tasks[0].task_id == pick.task_id  # the same work, which the agent dropped
 
 
-def test_a_task_that_keeps_failing_fails_its_action_with_the_agents_reason(gs):
+def test_a_permanent_failure_fails_its_action_at_once_with_the_agents_reason(gs):
     submit(gs, DeliverAction(tool="wrench", tool_station_id="tp-wrench", worker_id="W1"), "d")
-    for _ in range(3):
-        pick = gs.replanner.plans["uav-1"].tasks[0]
-        outcome(gs, "uav-1", pick, OutcomeResult.FAILED, reason="grabbed nothing at tp-wrench")
+    pick = gs.replanner.plans["uav-1"].tasks[0]
+    outcome(
+        gs,
+        "uav-1",
+        pick,
+        OutcomeResult.FAILED,
+        reason="grabbed nothing at tp-wrench",
+        reason_code="task_failed",
+    )
     record = gs.store.action("d")
     assert record.state == ActionState.FAILED
-    assert "grabbed nothing" in record.reason
+    assert "grabbed nothing" in record.reason and "task_failed" in record.reason
     failed = [e for e in gs.events if e.kind == EventKind.ACTION_FAILED]
     assert failed and "grabbed nothing" in failed[-1].detail
     assert not gs.replanner.plans["uav-1"].tasks or all(
         t.action_id != "d" for t in gs.replanner.plans["uav-1"].tasks
     )
+
+
+def test_a_retryable_failure_is_replanned_and_resent_until_its_reason_passes(gs):
+    submit(gs, DeliverAction(tool="wrench", tool_station_id="tp-wrench", worker_id="W1"), "d")
+    for _ in range(MAX_RETRYABLE_FAILURES - 1):
+        pick = gs.replanner.plans["uav-1"].tasks[0]
+        epoch = gs.replanner.plans["uav-1"].epoch
+        outcome(
+            gs,
+            "uav-1",
+            pick,
+            OutcomeResult.FAILED,
+            reason="arming refused: PreArm: AHRS: waiting for home",
+            retryable=True,
+            reason_code="arm_refused",
+        )
+        assert gs.store.action("d").state == ActionState.PLANNED
+        assert gs.replanner.plans["uav-1"].epoch > epoch  # sent again, always
+    pick = gs.replanner.plans["uav-1"].tasks[0]
+    outcome(gs, "uav-1", pick, OutcomeResult.FAILED, reason="no fix", retryable=True)
+    assert gs.store.action("d").state == ActionState.FAILED  # the guard: it never passed
 
 
 def test_outcomes_heard_before_the_uav_is_back_wait_for_it(tmp_path):

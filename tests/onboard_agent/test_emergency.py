@@ -85,7 +85,17 @@ def test_energy_below_what_reaching_a_station_needs_abandons_the_queue():
 
 def test_silent_autopilot_reports_the_uav_failed():
     rig = Rig()
+    rig.tick()  # heard once
+    rig.agent.status()
     rig.autopilot.update(link_ok=False)
     rig.tick()
     status = rig.agent.status()
     assert (status.state, status.reason) == ("failed", "no autopilot heartbeat")
+
+
+def test_an_autopilot_not_heard_yet_is_not_ready_not_failed():
+    rig = Rig()
+    rig.autopilot.update(link_ok=False)
+    rig.tick()
+    status = rig.agent.status()
+    assert status.state == "not_ready" and "heartbeat" in status.reason

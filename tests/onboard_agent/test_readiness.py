@@ -5,6 +5,7 @@ refuses to arm with its pre-arm texts until then."""
 from __future__ import annotations
 
 import asyncio
+import dataclasses
 import time
 
 import pytest
@@ -103,7 +104,6 @@ def test_agent_is_not_ready_not_failed_no_false_emergency_and_flies_once_warmed_
         command_ack_timeout_s=0.3,
         command_retries=1,
         heartbeat_timeout_s=1.0,
-        not_ready_state=True,
     )
 
     async def main() -> dict:
@@ -154,10 +154,13 @@ def test_agent_is_not_ready_not_failed_no_false_emergency_and_flies_once_warmed_
     assert not seen["texts"][0].startswith("PreArm:")  # it never tried to arm too early
 
 
-def test_not_ready_is_reported_as_idle_or_busy_with_ready_false_by_default(warming):
+def test_with_the_state_off_not_ready_is_reported_as_idle_or_busy_with_ready_false(warming):
+    """For a ground station that does not know the not-ready state."""
+    config = dataclasses.replace(CONFIG, not_ready_state=False)
+
     async def main():
-        link = MavlinkLink(url(warming), LocalFrame(SITE.origin), CONFIG)
-        agent = Agent("uav-1", SCENARIO, link, CONFIG)
+        link = MavlinkLink(url(warming), LocalFrame(SITE.origin), config)
+        agent = Agent("uav-1", SCENARIO, link, config)
         link.start()
         heartbeat = asyncio.create_task(link.run())
         try:

@@ -75,6 +75,8 @@ function fromEvent(e) {
     case "uav_back":
       if (!lost.delete(e.uav_id)) return null; // first contact at start-up: no alert
       return { severity: "info", title: "Link back", detail: `${uav}${e.detail}` };
+    case "uav_state":
+      return { severity: "info", title: "UAV not ready", detail: `${uav}${e.detail}` };
     case "action_failed":
       return { severity: "error", title: "Action failed", detail: `${action}${e.detail || "no reason given"}` };
     case "fault":

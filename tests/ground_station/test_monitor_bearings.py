@@ -1,0 +1,70 @@
+"""Monitoring actions of one worker take distinct bearings on the ring, so
+two of them never send UAVs to one point."""
+
+from __future__ import annotations
+
+import pytest
+
+from ground_station.monitor_bearings import choose_bearing, slot_bearings
+from proto import ModifyAction, MonitorAction, MonitorTask, SubmitAction
+from proto.errors import RequestError
+
+
+def watch(k: int = 1, bearing: float | None = None, worker: str = "W2") -> MonitorAction:
+    return MonitorAction(
+        worker_id=worker, uavs=k, standoff_m=4, duration_s=120, bearing_deg=bearing
+    )
+
+
+@pytest.mark.parametrize(
+    ("others", "k", "expected"),
+    [
+        ([], 1, 0.0),
+        ([watch(1, 0.0)], 1, 180.0),
+        ([watch(2, 0.0)], 1, 90.0),
+        ([watch(3, 0.0)], 3, 60.0),
+        ([watch(1, 0.0), watch(1, 180.0)], 2, 90.0),
+        ([watch(1, 30.0)], 2, 120.0),
+    ],
+)
+def test_the_bearing_chosen_is_farthest_from_the_other_slots(others, k, expected):
+    assert choose_bearing(watch(k), others) == expected
+
+
+def test_slots_follow_the_bearing_round_the_ring():
+    assert slot_bearings(watch(3, 350.0)) == pytest.approx([350.0, 110.0, 230.0])
+
+
+def submit(gs, action: MonitorAction, action_id: str):
+    gs.manager.submit(SubmitAction(request_id=action_id, action=action, action_id=action_id))
+    gs.settle()
+    return gs.store.action(action_id)
+
+
+def test_two_monitors_of_one_worker_send_their_uavs_to_opposite_sides(gs):
+    first = submit(gs, watch(), "m1")
+    second = submit(gs, watch(), "m2")
+    other_worker = submit(gs, watch(worker="W1"), "m3")
+    assert (first.action.bearing_deg, second.action.bearing_deg) == (0.0, 180.0)
+    assert other_worker.action.bearing_deg == 0.0  # another worker's ring
+    tasks = [t for p in gs.replanner.plans.values() for t in p.tasks if isinstance(t, MonitorTask)]
+    bearings = {t.action_id: t.bearing_deg for t in tasks}
+    assert bearings.get("m1") == 0.0 and bearings.get("m2") == 180.0
+
+
+def test_a_repeated_request_without_a_bearing_is_the_same_request(gs):
+    record = submit(gs, watch(), "m1")
+    submit(gs, watch(), "m2")
+    again = gs.manager.submit(SubmitAction(request_id="m2", action=watch(), action_id="m2"))
+    assert again.action.bearing_deg == 180.0
+    with pytest.raises(RequestError):  # the same id for another bearing: a conflict
+        gs.manager.submit(SubmitAction(request_id="m2", action=watch(bearing=90.0)))
+    assert record.action.bearing_deg == 0.0
+
+
+def test_an_operator_bearing_is_kept_and_a_modify_keeps_the_chosen_one(gs):
+    record = submit(gs, watch(bearing=45.0), "m1")
+    assert record.action.bearing_deg == 45.0
+    submit(gs, watch(), "m2")
+    gs.manager.modify(ModifyAction(request_id="edit", action_id="m2", action=watch(k=2)))
+    assert gs.store.action("m2").action.bearing_deg == 225.0
