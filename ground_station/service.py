@@ -26,7 +26,7 @@ from ground_station.replanner import Replanner
 from ground_station.store import Store
 from linecrew.bus import Bus
 from linecrew.process import Shutdown
-from proto.errors import RequestError
+from proto.errors import InvalidKey, RequestError
 from proto.keys import KeySpace, Role, UavTopic
 from proto.rpc import REQUEST_OPS, GetMetrics, GetPlans, MetricsReply, PlansReply, Reply, Request
 from proto.scenario import Scenario
@@ -49,6 +49,7 @@ class GroundStation:
         self.bus = bus
         self.clock = clock
         self.keys = KeySpace(scenario.site.id)
+        self.identity_mismatches = 0  # samples dropped: their ids disagree with their key
         self.store = Store(config.db_path)
         self.monitor = FleetMonitor([u.id for u in scenario.fleet.uavs], config.link_timeout_s)
         self.events = EventLog(self.store, lambda e: bus.publish(self.keys.events(), e), clock)
@@ -85,7 +86,7 @@ class GroundStation:
         try:
             for op in REQUEST_OPS:
                 bus.serve(keys.rpc(op), Request, self._rpc_handler(op))
-            bus.serve(keys.all_uavs(UavTopic.PLAN), GetPlans, self._plan_query)
+            bus.serve(keys.all_uavs(UavTopic.PLAN), GetPlans, self._plan_query, with_key=True)
             telemetry = bus.subscribe_async(keys.all_uavs(UavTopic.TELEMETRY), Telemetry)
             status = bus.subscribe_async(keys.all_uavs(UavTopic.STATUS), AgentStatus)
             outcomes = bus.subscribe_async(keys.all_uavs(UavTopic.OUTCOME), TaskOutcome)
@@ -121,18 +122,32 @@ class GroundStation:
             except Exception:
                 log.exception("failed to handle a message on %s", key)
 
-    def _on_telemetry(self, _key: str, telemetry: Telemetry) -> None:
-        if self.monitor.known(telemetry.uav_id):
+    def _bound(self, key: str, uav_id: str) -> bool:
+        """Whether a sample about ``uav_id`` came on that UAV's own key (under
+        the secured profile, only its certificate may publish there); one
+        that did not is dropped and counted."""
+        try:
+            parsed = self.keys.parse(key)
+        except InvalidKey:
+            parsed = None
+        if parsed is not None and parsed.kind == "uav" and parsed.ident == uav_id:
+            return self.monitor.known(uav_id)
+        self.identity_mismatches += 1
+        log.warning("dropped a sample about %s that came on %s", uav_id, key)
+        return False
+
+    def _on_telemetry(self, key: str, telemetry: Telemetry) -> None:
+        if self._bound(key, telemetry.uav_id):
             self.monitor.on_telemetry(telemetry, time.monotonic())
             self.manager.reports.on_telemetry(telemetry)
 
-    def _on_status(self, _key: str, status: AgentStatus) -> None:
-        self.monitor.on_status(status, time.monotonic())
-        if self.monitor.known(status.uav_id):
+    def _on_status(self, key: str, status: AgentStatus) -> None:
+        if self._bound(key, status.uav_id):
+            self.monitor.on_status(status, time.monotonic())
             self.manager.reports.on_status(status)
 
-    def _on_outcome(self, _key: str, outcome: TaskOutcome) -> None:
-        if self.monitor.known(outcome.uav_id):
+    def _on_outcome(self, key: str, outcome: TaskOutcome) -> None:
+        if self._bound(key, outcome.uav_id):
             self.manager.reports.on_outcome(outcome)
 
     def _on_token(self, key: str, alive: bool) -> None:
@@ -159,8 +174,16 @@ class GroundStation:
 
         return handle
 
-    def _plan_query(self, request: GetPlans) -> PlansReply:
-        plan = self.replanner.plans.get(request.uav_id or "")
+    def _plan_query(self, key: str, request: GetPlans) -> PlansReply:
+        """A UAV's plan, to the UAV whose key the query was sent to only."""
+        parsed = self.keys.parse(key)  # a wildcard query is no UAV's: refused
+        if parsed.kind != "uav" or request.uav_id not in (None, parsed.ident):
+            raise RequestError(
+                f"a query on {key} reads only the plan of {parsed.ident}",
+                code="forbidden",
+                field="uav_id",
+            )
+        plan = self.replanner.plans.get(parsed.ident or "")
         return PlansReply(plans=[plan] if plan else [], **self.manager.plan_quality())
 
     def metrics(self) -> dict[str, float]:
@@ -188,6 +211,7 @@ class GroundStation:
             "battery_replans": counters.battery_replans,
             "epoch": self.store.counter("epoch"),
             "bus_malformed": sum(self.bus.stats.malformed.values()),
+            "bus_identity_mismatch": self.identity_mismatches,
         }
         quality = {
             "plan_objective_s": "objective_s",

@@ -28,7 +28,7 @@ from proto.rpc import ErrorReply
 log = logging.getLogger(__name__)
 
 T = TypeVar("T")
-Handler = Callable[[Any], Awaitable[msgspec.Struct] | msgspec.Struct]
+Handler = Callable[..., Awaitable[msgspec.Struct] | msgspec.Struct]
 
 
 class Declared:
@@ -178,10 +178,14 @@ class Bus:
 
     # -- queries -----------------------------------------------------------------
 
-    def serve(self, key: str, request_type: type[T] | Any, handler: Handler) -> Declared:
+    def serve(
+        self, key: str, request_type: type[T] | Any, handler: Handler, *, with_key: bool = False
+    ) -> Declared:
         """Answer queries on ``key`` from the running asyncio loop.
 
-        ``handler(request)`` (sync or async) returns the reply message. A
+        ``handler(request)`` (sync or async; ``handler(query_key, request)``
+        ``with_key``, for a handler that trusts a query only as far as the
+        key it was sent to) returns the reply message. A
         :class:`LinecrewError` it raises, or a request that cannot be decoded,
         becomes an :class:`ErrorReply` sent as an error reply; an unexpected
         exception becomes ``internal_error`` and is logged."""
@@ -189,7 +193,8 @@ class Bus:
 
         def on_query(query: zenoh.Query) -> None:
             try:
-                loop.call_soon_threadsafe(self._spawn, self._answer(query, request_type, handler))
+                answer = self._answer(query, request_type, handler, with_key)
+                loop.call_soon_threadsafe(self._spawn, answer)
             except RuntimeError:  # loop closed while shutting down
                 query.drop()
 
@@ -200,12 +205,15 @@ class Bus:
         self._tasks.add(task)
         task.add_done_callback(self._tasks.discard)
 
-    async def _answer(self, query: zenoh.Query, request_type: Any, handler: Handler) -> None:
+    async def _answer(
+        self, query: zenoh.Query, request_type: Any, handler: Handler, with_key: bool
+    ) -> None:
         with query:
             key = str(query.key_expr)
             try:
                 payload = query.payload.to_bytes() if query.payload is not None else b""
-                result = handler(codec.decode(payload, request_type))
+                request = codec.decode(payload, request_type)
+                result = handler(key, request) if with_key else handler(request)
                 reply = await result if inspect.isawaitable(result) else result
             except LinecrewError as exc:
                 reply = ErrorReply(

@@ -17,10 +17,13 @@ from proto import (
     ActionList,
     ActionReply,
     ActionState,
+    AgentState,
+    AgentStatus,
     EventKind,
     GetAction,
     GetHistory,
     GetMetrics,
+    GetPlans,
     HistoryReply,
     InspectTask,
     KeySpace,
@@ -28,11 +31,14 @@ from proto import (
     MetricsReply,
     OutcomeResult,
     PickTask,
+    PlansReply,
     RequestError,
     Role,
     SubmitAction,
     TaskOutcome,
+    UavTopic,
 )
+from proto.errors import LinecrewError
 from tests.support.processes import Process, running, wait_until
 
 SCENARIO = load("paper")
@@ -191,6 +197,51 @@ def test_stale_outcomes_are_recorded_but_do_not_change_state(client, agents):
     )
     actions = client.query(KEYS.rpc("list_actions"), ListActions(), ActionList, 5.0)
     assert [r.state for r in actions.records] == [ActionState.PLANNED]
+
+
+def test_a_sample_whose_uav_disagrees_with_its_key_is_dropped_and_counted(client, agents):
+    """uav-2 publishing on its own key as uav-1: a completed delivery, an
+    emergency status and crashed telemetry of uav-1 change nothing."""
+    submit(client, "deliver-wrench")
+    uav1, uav2 = agents["uav-1"], agents["uav-2"]
+    wait_until(lambda: owner_of(agents, "deliver-wrench") is uav1, 10, "the delivery at uav-1")
+    plan = uav1.latest()
+    for task in plan.tasks:
+        spoof = TaskOutcome(
+            uav_id="uav-1",
+            task_id=task.task_id,
+            action_id=task.action_id,
+            epoch=plan.epoch,
+            result=OutcomeResult.COMPLETED,
+            tool="wrench",
+        )
+        uav2.bus.publish(KEYS.outcome("uav-2"), spoof)
+    status = AgentStatus(uav_id="uav-1", stamp_s=time.time(), state=AgentState.EMERGENCY)
+    uav2.bus.publish(KEYS.uav("uav-2", UavTopic.STATUS), status)
+
+    def mismatches() -> float:
+        metrics = client.query(KEYS.rpc("metrics"), GetMetrics(), MetricsReply, 5.0)
+        return metrics.values["bus_identity_mismatch"]
+
+    wait_until(lambda: mismatches() >= len(plan.tasks) + 1, 10, "the spoofed samples counted")
+    record = client.query(
+        KEYS.rpc("get_action"), GetAction(action_id="deliver-wrench"), ActionReply, 5.0
+    ).record
+    assert record.state == ActionState.PLANNED  # not completed by uav-2's word
+    assert owner_of(agents, "deliver-wrench") is uav1  # its work was not taken away
+    assert not [e for e in history(client).events if e.kind == EventKind.UAV_LOST]
+
+
+def test_a_uav_reads_only_its_own_plan(client, agents):
+    submit(client, "deliver-wrench")
+    wait_until(lambda: agents["uav-1"].latest().tasks, 10, "uav-1 has work")
+    own = client.query(KEYS.plan("uav-1"), GetPlans(uav_id="uav-1"), PlansReply, 5.0)
+    assert [p.uav_id for p in own.plans] == ["uav-1"]
+    with pytest.raises(RequestError) as refused:
+        client.query(KEYS.plan("uav-2"), GetPlans(uav_id="uav-1"), PlansReply, 5.0)
+    assert refused.value.code == "forbidden"
+    with pytest.raises(LinecrewError):  # a wildcard query is no UAV's
+        client.query(KEYS.all_uavs(UavTopic.PLAN), GetPlans(), PlansReply, 5.0)
 
 
 def test_kill_9_and_restart_loses_nothing_accepted(router, client, agents, gs, tmp_path):
