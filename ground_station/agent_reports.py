@@ -115,6 +115,8 @@ class AgentReports:
             or since is None
             or not since <= outcome.epoch <= plan.epoch
         ):
+            if self._credit_superseded(outcome):
+                return
             self.counters.stale_outcomes += 1
             self.events.emit(
                 EventKind.FAULT,
@@ -149,6 +151,35 @@ class AgentReports:
         )
         if trigger and not self._round_ending(outcome.uav_id, task):
             self.replan(f"{outcome.uav_id} {outcome.task_id} {outcome.result}")
+
+    def _credit_superseded(self, outcome: TaskOutcome) -> bool:
+        """An outcome of work the plan of its epoch gave the UAV, reported
+        after that plan was replaced (a ground station restarted while the
+        UAV flew, and replanned before hearing it): the work was done, so its
+        action is credited, idempotently (inspected waypoints, a tool picked
+        or delivered; never monitoring seconds, which a loss voids). The
+        current plan is left alone: an id such as ``uav-1.home`` may name
+        other work in it."""
+        if outcome.result != OutcomeResult.COMPLETED:
+            return False
+        then = self.book.store.plan_at(outcome.uav_id, outcome.epoch)
+        task = next((t for t in then.tasks if t.task_id == outcome.task_id), None) if then else None
+        if not isinstance(task, InspectTask | PickTask | DeliverTask) or task.action_id is None:
+            return False
+        record = self.book.store.action(task.action_id)
+        if record is None or record.state in TERMINAL:
+            return False
+        if isinstance(task, DeliverTask):
+            outcome = self._confirm_drop(outcome, task)
+            if outcome.result != OutcomeResult.COMPLETED:
+                return False
+        updated, event = apply_outcome(record, task, outcome)
+        why = f"{outcome.task_id} {outcome.result} (epoch {outcome.epoch}, reported late)"
+        self.book.save(updated, record.state, why)
+        if event is not None:
+            self.book.transition(updated, event, why)
+        self.replan(f"{outcome.uav_id} {outcome.task_id} reported late")
+        return True
 
     def release(self, uav_id: str) -> None:
         """``uav_id`` is back: apply the outcomes it sent meanwhile, in order."""

@@ -114,6 +114,14 @@ class Store:
         plans = [codec.decode(row[0], Plan) for row in rows]
         return {plan.uav_id: plan for plan in plans}
 
+    def plan_at(self, uav_id: str, epoch: int) -> Plan | None:
+        """The plan ``uav_id`` held at ``epoch`` (its newest plan up to it)."""
+        row = self._conn.execute(
+            "SELECT plan FROM plans WHERE uav_id = ? AND epoch <= ? ORDER BY epoch DESC LIMIT 1",
+            (uav_id, epoch),
+        ).fetchone()
+        return codec.decode(row[0], Plan) if row else None
+
     def append_event(self, event: GsEvent) -> None:
         """Store one event (its ``seq`` must be new)."""
         with self._transaction():

@@ -240,6 +240,36 @@ def test_outcomes_heard_before_the_uav_is_back_wait_for_it(tmp_path):
     assert not [e for e in restarted.events if "stale" in e.detail]
 
 
+def test_a_delivery_reported_after_a_restart_replanned_without_the_uav_counts(tmp_path):
+    """The ground station restarts while uav-1 carries the wrench; the other
+    UAVs come back first and the replan takes uav-1's plan away (new epoch).
+    uav-1's re-delivered "drop completed" of the old epoch is still true:
+    the delivery completes, and is not picked again."""
+    first = Harness(str(tmp_path / "gs.db"))
+    first.bring_up(*ALL)
+    submit(first, DeliverAction(tool="wrench", tool_station_id="tp-wrench", worker_id="W1"), "d")
+    pick, drop = first.replanner.plans["uav-1"].tasks[:2]
+    epoch = first.replanner.plans["uav-1"].epoch
+    outcome(first, "uav-1", pick, tool="wrench")
+    assert first.store.action("d").state == ActionState.IN_PROGRESS
+    restarted = Harness(str(tmp_path / "gs.db"), now=first.now + 5)
+    restarted.bring_up("uav-2", "uav-3")  # uav-1 not heard yet: its plan is emptied
+    assert restarted.replanner.plans["uav-1"].epoch > epoch
+    restarted.bring_up("uav-1")
+    late = TaskOutcome(
+        uav_id="uav-1",
+        task_id=drop.task_id,
+        action_id="d",
+        epoch=epoch,
+        tool="wrench",
+        result=OutcomeResult.COMPLETED,
+    )
+    restarted.manager.reports.on_outcome(late)
+    restarted.settle()
+    assert restarted.store.action("d").state == ActionState.COMPLETED
+    assert not [e for e in restarted.events if "stale" in e.detail]
+
+
 def test_a_monitor_short_of_its_duration_by_a_few_seconds_ends_and_says_so(gs):
     submit(gs, MonitorAction(worker_id="W2", uavs=1, standoff_m=4, duration_s=120), "watch")
     uav, segment = next(
