@@ -71,6 +71,7 @@ class Agent:
         self.tree = py_trees.trees.BehaviourTree(self.root)
         self.emergency = Emergency(self.ctx)
         self._autopilot_seen = False  # a heartbeat has been heard since the start
+        self._ready_once = False  # the autopilot could arm at least once since the start
         self._last_status: tuple[object, ...] = ()
 
     @property
@@ -123,9 +124,14 @@ class Agent:
         if ctx.recharging or (self.root.tip() is not None and "Recharge" in self.active_path()):
             return AgentState.RECHARGING, ""
         why = self.not_ready()
+        self._ready_once |= not why
         if why:
+            # not ready to fly at all (the autopilot's start-up) until first ready; a
+            # refusal after that (a low battery on the pad) is a passing one: the
+            # state stays and ``ready`` says it, as arming retries and outcomes do
             state = AgentState.IDLE if self.mission.head is None else AgentState.BUSY
-            return (AgentState.NOT_READY if ctx.config.not_ready_state else state), why
+            booting = ctx.config.not_ready_state and not self._ready_once
+            return (AgentState.NOT_READY if booting else state), why
         if self.mission.head is None:
             return AgentState.IDLE, ""
         return AgentState.BUSY, ""

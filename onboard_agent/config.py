@@ -42,9 +42,9 @@ class AgentConfig:
     retry_backoff_s: float = 1.0  # first wait after a refusal (mission s); doubles each time
     retry_backoff_max_s: float = 16.0  # longest wait between two tries
     ready_timeout_s: float = 120.0  # a task waits this long for the autopilot to become ready
-    not_ready_state: bool = True  # publish AgentState.NOT_READY while the autopilot cannot
-    # arm (the gs gives the work to others until it can); False keeps IDLE / BUSY with
-    # ready=False and the reason, for a gs that does not know the state
+    not_ready_state: bool = True  # publish AgentState.NOT_READY until the autopilot can
+    # first arm (the gs gives the work to others until it can); False keeps IDLE / BUSY
+    # with ready=False and the reason, for a gs that does not know the state
     command_ack_timeout_s: float = 1.0  # wait this long for a COMMAND_ACK
     command_retries: int = 3  # resend an unacknowledged command this many times
     heartbeat_timeout_s: float = 3.0  # no autopilot HEARTBEAT this long -> link lost

@@ -214,6 +214,18 @@ def test_a_retryable_failure_is_replanned_and_resent_until_its_reason_passes(gs)
     assert gs.store.action("d").state == ActionState.FAILED  # the guard: it never passed
 
 
+def wrench_outcome(task, epoch: int) -> TaskOutcome:
+    """uav-1's report that ``task`` of delivery "d" completed, holding the wrench."""
+    return TaskOutcome(
+        uav_id="uav-1",
+        task_id=task.task_id,
+        action_id="d",
+        epoch=epoch,
+        tool="wrench",
+        result=OutcomeResult.COMPLETED,
+    )
+
+
 def test_outcomes_heard_before_the_uav_is_back_wait_for_it(tmp_path):
     """A restarted ground station hears re-delivered outcomes before it has
     seen the UAV's token and telemetry: they apply once the UAV is back."""
@@ -223,16 +235,7 @@ def test_outcomes_heard_before_the_uav_is_back_wait_for_it(tmp_path):
     pick = first.replanner.plans["uav-1"].tasks[0]
     epoch = first.replanner.plans["uav-1"].epoch
     restarted = Harness(str(tmp_path / "gs.db"), now=first.now + 5)
-    restarted.manager.reports.on_outcome(
-        TaskOutcome(
-            uav_id="uav-1",
-            task_id=pick.task_id,
-            action_id="d",
-            epoch=epoch,
-            tool="wrench",
-            result=OutcomeResult.COMPLETED,
-        )
-    )
+    restarted.manager.reports.on_outcome(wrench_outcome(pick, epoch))
     restarted.settle()
     assert restarted.store.action("d").state == ActionState.PLANNED  # held, not lost nor stale
     restarted.bring_up(*ALL)
@@ -256,15 +259,7 @@ def test_a_delivery_reported_after_a_restart_replanned_without_the_uav_counts(tm
     restarted.bring_up("uav-2", "uav-3")  # uav-1 not heard yet: its plan is emptied
     assert restarted.replanner.plans["uav-1"].epoch > epoch
     restarted.bring_up("uav-1")
-    late = TaskOutcome(
-        uav_id="uav-1",
-        task_id=drop.task_id,
-        action_id="d",
-        epoch=epoch,
-        tool="wrench",
-        result=OutcomeResult.COMPLETED,
-    )
-    restarted.manager.reports.on_outcome(late)
+    restarted.manager.reports.on_outcome(wrench_outcome(drop, epoch))
     restarted.settle()
     assert restarted.store.action("d").state == ActionState.COMPLETED
     assert not [e for e in restarted.events if "stale" in e.detail]

@@ -99,3 +99,13 @@ def test_an_autopilot_not_heard_yet_is_not_ready_not_failed():
     rig.tick()
     status = rig.agent.status()
     assert status.state == "not_ready" and "heartbeat" in status.reason
+
+
+def test_a_refusal_after_the_first_ready_is_passing_not_a_not_ready_state():
+    rig = Rig()
+    rig.tick()
+    assert rig.agent.status().ready  # ready once
+    rig.autopilot.update(prearm_ok=False)  # e.g. a low battery on the pad
+    rig.tick()
+    status = rig.agent.status()
+    assert status.state == "idle" and not status.ready and "pre-arm" in status.reason
