@@ -141,18 +141,27 @@ def test_work_asked_while_the_autopilots_warm_up_waits_for_them_then_flies(tmp_p
 
 
 def test_two_monitors_of_one_worker_are_flown_on_opposite_sides(truth):
-    """Two k = 1 monitoring actions of W2 at once: the simulator sees both
-    UAVs on the ring, never at one point (each action has its own bearing)."""
+    """Two k = 1 monitoring actions of W2 at once: the simulator sees their
+    UAVs hold opposite points of the ring, never one point (each action has
+    its own bearing)."""
     first = truth.submit(monitor("W2", 1, 90))["action_id"]
     second = truth.submit(monitor("W2", 1, 90))["action_id"]
     truth.until("both monitors end", lambda: truth.finished(first, second), 150)
     assert truth.action(first)["state"] == truth.action(second)["state"] == "completed"
-    together = []
+    height = W2.z_m + SAFETY.monitor_height_m
+    slots = [(W2.x_m + 4.0, W2.y_m, height), (W2.x_m - 4.0, W2.y_m, height)]  # 0 and 180 deg
+    both_held, shared = 0, 0
     for sample in truth.samples:
-        on_ring = truth.watching(sample, W2, 4.0, SAFETY.monitor_height_m)
-        if len(on_ring) == 2:
-            a, b = (v.position for v in sample.state.vehicles if v.uav_id in on_ring)
-            together.append(math.dist((a.x_m, a.y_m, a.z_m), (b.x_m, b.y_m, b.z_m)))
-    assert len(together) > 20, "the two were hardly on the ring together"
-    assert min(together) > 6.0  # opposite sides of a 4 m ring: 8 m apart
+        at = [
+            [v.uav_id for v in sample.state.vehicles if math.dist(_xyz(v.position), slot) < 1.5]
+            for slot in slots
+        ]
+        both_held += all(at)
+        shared += any(len(held) > 1 for held in at)
+    assert both_held > 20, "the two slots were hardly held together"
+    assert shared == 0, f"two UAVs at one slot in {shared} samples"
     assert not truth.violations(*UNSAFE)
+
+
+def _xyz(p) -> tuple[float, float, float]:
+    return (p.x_m, p.y_m, p.z_m)
