@@ -22,7 +22,7 @@ from ground_station.lifecycle import TERMINAL, ActionEvent
 from ground_station.progress import apply_outcome
 from ground_station.replanner import Replanner
 from proto.events import EventKind
-from proto.mission import ActionState
+from proto.mission import ActionRecord, ActionState
 from proto.plan import DeliverTask, InspectTask, MonitorTask, PickTask, RechargeTask, Task
 from proto.rpc import UavOpState
 from proto.scenario import Scenario
@@ -131,10 +131,7 @@ class AgentReports:
         if task.action_id is not None:
             record = self.book.store.action(task.action_id)
             if record is not None and record.state not in TERMINAL:
-                updated, event = apply_outcome(record, task, outcome)
-                self.book.save(updated, record.state, f"{outcome.task_id} {outcome.result}")
-                if event is not None:
-                    self.book.transition(updated, event, f"{outcome.task_id} {outcome.result}")
+                self._credit(record, task, outcome, f"{outcome.task_id} {outcome.result}")
         if isinstance(task, MonitorTask) and outcome.result == OutcomeResult.COMPLETED:
             self._announce_handover(outcome.uav_id, task)
         self.replanner.finished(outcome.uav_id, outcome.task_id)
@@ -173,13 +170,17 @@ class AgentReports:
             outcome = self._confirm_drop(outcome, task)
             if outcome.result != OutcomeResult.COMPLETED:
                 return False
-        updated, event = apply_outcome(record, task, outcome)
         why = f"{outcome.task_id} {outcome.result} (epoch {outcome.epoch}, reported late)"
+        self._credit(record, task, outcome, why)
+        self.replan(f"{outcome.uav_id} {outcome.task_id} reported late")
+        return True
+
+    def _credit(self, record: ActionRecord, task: Task, outcome: TaskOutcome, why: str) -> None:
+        """Apply ``outcome`` of ``task`` to its action's ``record``."""
+        updated, event = apply_outcome(record, task, outcome)
         self.book.save(updated, record.state, why)
         if event is not None:
             self.book.transition(updated, event, why)
-        self.replan(f"{outcome.uav_id} {outcome.task_id} reported late")
-        return True
 
     def release(self, uav_id: str) -> None:
         """``uav_id`` is back: apply the outcomes it sent meanwhile, in order."""

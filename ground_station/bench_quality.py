@@ -27,6 +27,7 @@ from ground_station.event_log import EventLog
 from ground_station.fleet_monitor import FleetMonitor
 from ground_station.missions import MissionManager
 from ground_station.planner.api import score
+from ground_station.planner.cli import deadline
 from ground_station.planning import build_problem
 from ground_station.replan_jobs import ImproveSettings
 from ground_station.replanner import Replanner
@@ -97,8 +98,8 @@ def live_and_offline(
     problem = build_problem(
         scenario.site, scenario.fleet, job.uavs, job.records, NOW_S, monitor_starts=job.starts
     )
-    end = time.perf_counter() + offline_ms / 1000.0
-    offline = score(pl.plan(problem, should_stop=lambda: time.perf_counter() >= end))
+    stop, _ = deadline(offline_ms)
+    offline = score(pl.plan(problem, should_stop=stop))  # type: ignore[arg-type]
     epochs = store.counter("epoch")
     store.close()
     return {

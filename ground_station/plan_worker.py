@@ -93,9 +93,7 @@ class PlanWorker:
         """Run the pending replans now (and, if ``improve``, the improvement
         attempts due), on the caller's thread."""
         manager = self.manager
-        while self._reasons:
-            reason = self._take()
-            manager.finish_replan(manager.replanner.compute(manager.prepare_replan(reason)))
+        self._replan_pending()
         if not (improve and self.improve):
             return
         for _ in range(max_improvements):
@@ -103,9 +101,13 @@ class PlanWorker:
                 return
             job = manager.prepare_improvement()
             manager.finish_improvement(manager.replanner.improve(job))
-            while self._reasons:  # an adopted plan may trigger nothing, but be safe
-                reason = self._take()
-                manager.finish_replan(manager.replanner.compute(manager.prepare_replan(reason)))
+            self._replan_pending()  # an adopted plan may trigger nothing, but be safe
+
+    def _replan_pending(self) -> None:
+        manager = self.manager
+        while self._reasons:
+            reason = self._take()
+            manager.finish_replan(manager.replanner.compute(manager.prepare_replan(reason)))
 
     # -- the worker task ---------------------------------------------------------------
 
