@@ -50,18 +50,32 @@ class ActionBook:
 
     def transition(self, record: ActionRecord, event: ActionEvent, reason: str) -> None:
         """Apply a lifecycle event; a change of state is saved and announced."""
-        state = next_state(record.state, event)
-        if state != record.state:
-            self.save(
-                msgspec.structs.replace(record, state=state, reason=reason), record.state, reason
-            )
+        self.update(record, record, event, reason)
+
+    def update(
+        self,
+        before: ActionRecord,
+        after: ActionRecord,
+        event: ActionEvent | None,
+        reason: str,
+    ) -> None:
+        """Save ``after`` over ``before`` in one write, in the state ``event``
+        leads to (if any); a change of state is announced once saved."""
+        state = after.state if event is None else next_state(before.state, event)
+        changed = state != before.state
+        if changed:
+            after = msgspec.structs.replace(after, state=state, reason=reason)
+        elif after == before:
+            return
+        self.save(after, before.state, reason)
+        if changed:
             self.events.emit(
                 EventKind.ACTION_STATE,
-                action_id=record.action_id,
-                detail=f"{record.state}->{state}: {reason}",
+                action_id=before.action_id,
+                detail=f"{before.state}->{state}: {reason}",
             )
             if state == ActionState.FAILED:
-                self.events.emit(EventKind.ACTION_FAILED, action_id=record.action_id, detail=reason)
+                self.events.emit(EventKind.ACTION_FAILED, action_id=before.action_id, detail=reason)
 
     def save(self, record: ActionRecord, previous: ActionState, reason: str) -> None:
         """Store ``record`` (stamped now) over its ``previous`` state."""

@@ -10,6 +10,7 @@ home) and hands them to ``replan``.
 from __future__ import annotations
 
 import dataclasses
+import logging
 from collections.abc import Callable
 
 import msgspec
@@ -21,6 +22,7 @@ from ground_station.fleet_monitor import FleetMonitor
 from ground_station.lifecycle import TERMINAL, ActionEvent
 from ground_station.progress import apply_outcome
 from ground_station.replanner import Replanner
+from ground_station.store import StoreUnavailable
 from proto.events import EventKind
 from proto.mission import ActionRecord, ActionState
 from proto.plan import DeliverTask, InspectTask, MonitorTask, PickTask, RechargeTask, Task
@@ -34,6 +36,8 @@ from proto.telemetry import (
     TaskOutcome,
     Telemetry,
 )
+
+log = logging.getLogger(__name__)
 
 ACTION_TASKS = (InspectTask, MonitorTask, PickTask, DeliverTask)
 """Tasks whose completion is a replanning trigger (the paper's "task
@@ -96,16 +100,36 @@ class AgentReports:
         self._carried: dict[str, str] = {}  # the last tool each UAV's telemetry showed
         self._failures: dict[str, int] = {}  # failed outcomes per task id
         self._held: dict[str, list[TaskOutcome]] = {}  # from UAVs not back yet
+        self._unsaved: list[TaskOutcome] = []  # the store could not take them yet
         self._idle_since: dict[str, float] = {}  # agent idle while its plan has tasks
 
     def on_outcome(self, outcome: TaskOutcome) -> None:
         """Apply an agent's outcome; stale ones are recorded only. An outcome
         from a UAV not yet back (a restarted ground station hears re-delivered
-        outcomes before the token and telemetry) waits until it is back."""
+        outcomes before the token and telemetry) waits until it is back; one
+        the store could not take waits for :meth:`retry_unsaved`."""
         if self.monitor.state(outcome.uav_id) == UavOpState.LOST:
             self._held.setdefault(outcome.uav_id, []).append(outcome)
             return
         self.counters.outcomes += 1
+        self._apply_or_keep(outcome)
+
+    def retry_unsaved(self) -> None:
+        """Apply again, in order, the outcomes the store could not take."""
+        unsaved, self._unsaved = self._unsaved, []
+        for outcome in unsaved:
+            self._apply_or_keep(outcome)
+
+    def _apply_or_keep(self, outcome: TaskOutcome) -> None:
+        try:
+            self._apply(outcome)
+        except StoreUnavailable as exc:  # its credit, the first write, was not kept
+            self._unsaved.append(outcome)
+            log.error(
+                "outcome %s of %s waits for the store: %s", outcome.task_id, outcome.uav_id, exc
+            )
+
+    def _apply(self, outcome: TaskOutcome) -> None:
         plan = self.replanner.plans.get(outcome.uav_id)
         task = next((t for t in plan.tasks if t.task_id == outcome.task_id), None) if plan else None
         since = self.replanner.assigned_since(outcome.uav_id, outcome.task_id)
@@ -135,7 +159,7 @@ class AgentReports:
         if isinstance(task, MonitorTask) and outcome.result == OutcomeResult.COMPLETED:
             self._announce_handover(outcome.uav_id, task)
         self.replanner.finished(outcome.uav_id, outcome.task_id)
-        if outcome.result == OutcomeResult.FAILED and self._gave_up(task, outcome, judged):
+        if outcome.result == OutcomeResult.FAILED and self._gave_up_safely(task, outcome, judged):
             return
         if outcome.result != OutcomeResult.COMPLETED:
             # the agent dropped the task: if the replan gives it back unchanged
@@ -178,14 +202,21 @@ class AgentReports:
     def _credit(self, record: ActionRecord, task: Task, outcome: TaskOutcome, why: str) -> None:
         """Apply ``outcome`` of ``task`` to its action's ``record``."""
         updated, event = apply_outcome(record, task, outcome)
-        self.book.save(updated, record.state, why)
-        if event is not None:
-            self.book.transition(updated, event, why)
+        self.book.update(record, updated, event, why)
 
     def release(self, uav_id: str) -> None:
         """``uav_id`` is back: apply the outcomes it sent meanwhile, in order."""
         for outcome in self._held.pop(uav_id, []):
             self.on_outcome(outcome)
+
+    def _gave_up_safely(self, task: Task, outcome: TaskOutcome, judged: bool) -> bool:
+        """:meth:`_gave_up`, after the credit was kept: a store failure now
+        leaves the action in force (the next failure of the task fails it)."""
+        try:
+            return self._gave_up(task, outcome, judged)
+        except StoreUnavailable as exc:
+            log.error("failing the action of %s waits for the store: %s", task.task_id, exc)
+            return False
 
     def _gave_up(self, task: Task, outcome: TaskOutcome, judged: bool) -> bool:
         """Whether the failure of ``task`` fails its action (then the work is

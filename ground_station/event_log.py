@@ -2,15 +2,22 @@
 
 from __future__ import annotations
 
+import logging
 from collections.abc import Callable
 
-from ground_station.store import Store
+from ground_station.store import Store, StoreUnavailable
 from proto.events import EventKind, GsEvent
+
+log = logging.getLogger(__name__)
 
 
 class EventLog:
     """Emits :class:`GsEvent` with consecutive ``seq`` (continuing after a
-    restart), stores each one, and hands it to ``publish``."""
+    restart), stores each one, and hands it to ``publish``.
+
+    An event the store cannot take is still published and kept in order
+    until :meth:`flush` (each emit, and the watchdog) stores it: what
+    happened is never lost to a full disk, nor does it stop what follows."""
 
     def __init__(
         self, store: Store, publish: Callable[[GsEvent], None], clock: Callable[[], float]
@@ -19,6 +26,13 @@ class EventLog:
         self._publish = publish
         self._clock = clock
         self._seq = store.last_event_seq()
+        self._unstored: list[GsEvent] = []
+        self._said = False  # the store's failure was logged
+
+    @property
+    def unstored(self) -> int:
+        """Events published but not yet in the store."""
+        return len(self._unstored)
 
     def emit(
         self,
@@ -40,6 +54,20 @@ class EventLog:
             epoch=epoch,
             detail=detail,
         )
-        self._store.append_event(event)
+        self._unstored.append(event)
+        self.flush()
         self._publish(event)
         return event
+
+    def flush(self) -> None:
+        """Store the events not stored yet, oldest first, while the store takes them."""
+        while self._unstored:
+            try:
+                self._store.append_event(self._unstored[0])
+            except StoreUnavailable as exc:
+                if not self._said:
+                    log.error("events wait for the store: %s", exc)
+                self._said = True
+                return
+            self._unstored.pop(0)
+        self._said = False

@@ -8,6 +8,7 @@ import sys
 
 from ground_station.config import GsConfig
 from ground_station.service import GroundStation
+from ground_station.store import StoreUnavailable
 from linecrew.bus import Bus
 from linecrew.clock import mission_clock
 from linecrew.process import Shutdown, common_parser, start
@@ -45,7 +46,11 @@ def main(argv: list[str] | None = None) -> int:
         log.error("ground station cannot start: %s", exc)
         return 1
     with bus:
-        station = GroundStation(config, scenario, bus, clock=mission_clock(args.speedup))
+        try:
+            station = GroundStation(config, scenario, bus, clock=mission_clock(args.speedup))
+        except StoreUnavailable as exc:
+            log.error("ground station cannot start: %s", exc)
+            return 1
         asyncio.run(station.run(shutdown))
     log.info("ground station stopped on %s", shutdown.signal_name or "request")
     return 0

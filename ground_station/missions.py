@@ -28,7 +28,7 @@ from ground_station.monitor_bearings import as_requested, with_bearing
 from ground_station.plan_worker import PlanWorker
 from ground_station.replan_jobs import Computed, Job, ReplanOutcome
 from ground_station.replanner import Replanner
-from ground_station.store import Store
+from ground_station.store import Store, StoreUnavailable
 from ground_station.validation import validate
 from proto.errors import RequestError
 from proto.events import EventKind
@@ -110,6 +110,8 @@ class MissionManager:
         self.clock = clock
         self.book = ActionBook(store, events, clock)
         self._retried_s = clock()
+        self._unvoided: list[str] = []  # lost UAVs whose segments the store has yet to void
+        self._store_said: str | None = None  # the store failure last told the operator
         self.worker = PlanWorker(self, improve=improve, improve_delay_s=improve_delay_s)
         self.reports = AgentReports(
             scenario=scenario,
@@ -238,12 +240,42 @@ class MissionManager:
             if change == Change.BACK:
                 self.replanner.resend(uav_id)
             else:
-                self._void_segments(uav_id)
+                self._unvoided.append(uav_id)
+        self._void_pending()
         if changes:
             self.request_replan(", ".join(f"{u} {c}" for u, c in changes), stale=True)
         for uav_id, change in changes:
             if change == Change.BACK:
                 self.reports.release(uav_id)
+
+    def retry_unsaved(self) -> None:
+        """What the store could not take, tried again (each watchdog step):
+        events, agents' outcomes, the voiding of a lost UAV's segments. The
+        operator is told when the store starts failing and when it is back."""
+        self.events.flush()
+        if self.store.failing != self._store_said:
+            self._store_said = self.store.failing
+            detail = (
+                f"the store cannot write ({self._store_said}): new actions are refused (503) "
+                "and reports wait until it can"
+                if self._store_said
+                else "the store writes again"
+            )
+            self.events.emit(EventKind.FAULT, detail=detail)
+        self.reports.retry_unsaved()
+        if self._unvoided:
+            self._void_pending()
+            if not self._unvoided:
+                self.request_replan("the store writes again")
+
+    def _void_pending(self) -> None:
+        while self._unvoided:
+            try:
+                self._void_segments(self._unvoided[0])
+            except StoreUnavailable as exc:
+                log.error("voiding %s's segments waits for the store: %s", self._unvoided[0], exc)
+                return
+            self._unvoided.pop(0)
 
     def _void_segments(self, uav_id: str) -> None:
         """A lost UAV's monitoring assignments end with the loss: its later

@@ -10,7 +10,9 @@ finished, an action cancelled, a UAV lost) is dropped and the replan run
 again. When no trigger has come for ``improve_delay_s``, the worker tries to
 improve the live plan (bounded rounds, on the same thread; a trigger
 interrupts it and the attempt is dropped), and stops trying for a state once
-an attempt is not adopted: a steady mission plans nothing.
+an attempt is not adopted: a steady mission plans nothing. A result the
+store cannot take is not adopted: its reason waits, and the replan is run
+again every ``STORE_RETRY_S`` until the store writes.
 
 ``settle()`` does the same synchronously (tests, and any caller that must
 see the plan follow at once).
@@ -23,10 +25,16 @@ import dataclasses
 import logging
 from typing import TYPE_CHECKING
 
+from ground_station.store import StoreUnavailable
+
 if TYPE_CHECKING:
     from ground_station.missions import MissionManager
+    from ground_station.replan_jobs import Computed
 
 log = logging.getLogger(__name__)
+
+STORE_RETRY_S = 1.0
+"""Wall seconds between attempts to commit a plan while the store fails."""
 
 
 @dataclasses.dataclass
@@ -107,7 +115,18 @@ class PlanWorker:
         manager = self.manager
         while self._reasons:
             reason = self._take()
-            manager.finish_replan(manager.replanner.compute(manager.prepare_replan(reason)))
+            self._finish(reason, manager.replanner.compute(manager.prepare_replan(reason)))
+
+    def _finish(self, reason: str, computed: Computed) -> None:
+        """Commit ``computed``; its reason waits for the next replan if the
+        mission outran it, or the store could not take it (raised)."""
+        try:
+            finished = self.manager.finish_replan(computed)
+        except StoreUnavailable:
+            self._reasons.insert(0, reason)
+            raise
+        if finished is None:
+            self._reasons.insert(0, reason)
 
     # -- the worker task ---------------------------------------------------------------
 
@@ -129,6 +148,9 @@ class PlanWorker:
                         await self._wake.wait()
             except asyncio.CancelledError:
                 raise
+            except StoreUnavailable as exc:
+                log.error("planning waits for the store: %s", exc)
+                await asyncio.sleep(STORE_RETRY_S)
             except Exception:
                 log.exception("planning worker step failed")
                 await asyncio.sleep(0.05)
@@ -155,8 +177,7 @@ class PlanWorker:
             computed = await asyncio.to_thread(manager.replanner.compute, job)
         finally:
             self.busy = False
-        if manager.finish_replan(computed) is None:  # the mission moved on: again
-            self._reasons.insert(0, reason)
+        self._finish(reason, computed)
 
     async def _improve_once(self) -> None:
         manager = self.manager

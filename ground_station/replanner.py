@@ -30,7 +30,7 @@ from ground_station.live_plan import (
 )
 from ground_station.planning import build_problem, monitor_starts, same_work, to_tasks
 from ground_station.replan_jobs import Computed, ImproveSettings, Job, ReplanOutcome, ReplanStats
-from ground_station.store import Store
+from ground_station.store import Store, StoreUnavailable
 from proto.events import EventKind
 from proto.mission import ActionRecord
 from proto.plan import Plan
@@ -211,12 +211,16 @@ class Replanner:
         changed: list[Plan] = []
         now_s = job.now_s
         if changed_ids:
-            epoch = self.store.next_counter("epoch")
-            changed = [
-                Plan(uav_id=u, epoch=epoch, issued_s=now_s, tasks=new_tasks.get(u, []))
-                for u in changed_ids
-            ]
-            self.store.save_plans(changed)
+            try:
+                epoch = self.store.next_counter("epoch")
+                changed = [
+                    Plan(uav_id=u, epoch=epoch, issued_s=now_s, tasks=new_tasks.get(u, []))
+                    for u in changed_ids
+                ]
+                self.store.save_plans(changed)
+            except StoreUnavailable:
+                self.live.invalidate()  # the session holds a plan that was not adopted
+                raise
             for plan in changed:
                 self._hold(plan)
                 if self.monitor.available(plan.uav_id) or plan.uav_id in self._resend:

@@ -158,6 +158,7 @@ class GroundStation:
     async def _watchdog(self) -> None:
         while True:
             try:
+                self.manager.retry_unsaved()
                 self.manager.on_fleet_changes(self.monitor.check(time.monotonic()))
                 self.manager.retry_unplaced()
             except Exception:
@@ -212,6 +213,8 @@ class GroundStation:
             "epoch": self.store.counter("epoch"),
             "bus_malformed": sum(self.bus.stats.malformed.values()),
             "bus_identity_mismatch": self.identity_mismatches,
+            "store_failing": float(self.store.failing is not None),
+            "events_unstored": self.events.unstored,
         }
         quality = {
             "plan_objective_s": "objective_s",

@@ -21,6 +21,7 @@ STATUS_BY_CODE: dict[str, int] = {
     "invalid_transition": 409,
     "request_timeout": 503,
     "unavailable": 503,
+    "store_unavailable": 503,
     "unauthorized": 401,
     "body_too_large": 413,
 }

@@ -4,6 +4,11 @@ Every accepted action and every state transition is committed (fsync'd,
 ``synchronous=FULL``) before the caller replies, so a ``kill -9`` at any
 moment loses nothing that was acknowledged. All methods run on the caller's
 thread; the ground station uses it from its event loop only.
+
+A write that fails (disk full, file made read-only, I/O error) is rolled
+back whole and raises :class:`StoreUnavailable`: the caller's state must be
+left as it was and the write tried again later. A store that cannot be
+opened, migrated or written at start raises it too, with the cause.
 """
 
 from __future__ import annotations
@@ -14,21 +19,37 @@ from typing import Any
 
 from ground_station.store.migrations import migrate
 from proto import codec
+from proto.errors import RequestError
 from proto.events import GsEvent
 from proto.mission import ActionRecord, ActionState
 from proto.plan import Plan
 
 
+class StoreUnavailable(RequestError):
+    """The store cannot write (disk full, read-only, I/O error): nothing of
+    the request was kept. Retry once the disk is fixed (HTTP 503)."""
+
+    code = "store_unavailable"
+
+
 class Store:
-    """Actions, transitions, plans by epoch, events and counters in one file."""
+    """Actions, transitions, plans by epoch, events and counters in one file.
+
+    ``failing`` holds the cause of the last failed write until a write
+    succeeds again (None while writes succeed)."""
 
     def __init__(self, path: str) -> None:
         self.path = path
-        self._conn = sqlite3.connect(path, isolation_level=None)
-        self._conn.execute("PRAGMA journal_mode=WAL")
-        self._conn.execute("PRAGMA synchronous=FULL")
-        self._conn.execute("PRAGMA foreign_keys=ON")
-        self.schema_version = migrate(self._conn)
+        self.failing: str | None = None
+        try:
+            self._conn = sqlite3.connect(path, isolation_level=None)
+            self._conn.execute("PRAGMA journal_mode=WAL")
+            self._conn.execute("PRAGMA synchronous=FULL")
+            self._conn.execute("PRAGMA foreign_keys=ON")
+            self.schema_version = migrate(self._conn)
+            self.next_counter("starts")  # proves the file takes writes now
+        except sqlite3.Error as exc:
+            raise StoreUnavailable(f"the store {path} cannot be used: {exc}") from exc
 
     def close(self) -> None:
         """Close the file (a checkpoint folds the WAL back in)."""
@@ -167,21 +188,42 @@ class Store:
         )
 
     def _transaction(self) -> Any:
-        return _Transaction(self._conn)
+        return _Transaction(self)
 
 
 class _Transaction:
-    """``BEGIN IMMEDIATE`` ... ``COMMIT`` (or ``ROLLBACK`` on error); nests."""
+    """``BEGIN IMMEDIATE`` ... ``COMMIT`` (or ``ROLLBACK`` on error); nests.
+    A database error inside is rolled back and raised as StoreUnavailable."""
 
-    def __init__(self, conn: sqlite3.Connection) -> None:
-        self._conn = conn
+    def __init__(self, store: Store) -> None:
+        self._store = store
+        self._conn = store._conn
         self._outer = False
 
     def __enter__(self) -> None:
         self._outer = not self._conn.in_transaction
         if self._outer:
-            self._conn.execute("BEGIN IMMEDIATE")
+            self._run("BEGIN IMMEDIATE")
 
-    def __exit__(self, exc_type: object, *_: object) -> None:
-        if self._outer:
-            self._conn.execute("ROLLBACK" if exc_type else "COMMIT")
+    def __exit__(self, exc_type: object, exc: object, _tb: object) -> None:
+        if not self._outer:
+            return
+        if exc_type is None:
+            self._run("COMMIT")
+            self._store.failing = None
+        elif isinstance(exc, sqlite3.OperationalError):  # the disk, not the data
+            self._fail(exc)
+        elif self._conn.in_transaction:
+            self._conn.execute("ROLLBACK")
+
+    def _run(self, statement: str) -> None:
+        try:
+            self._conn.execute(statement)
+        except sqlite3.OperationalError as exc:
+            self._fail(exc)
+
+    def _fail(self, exc: sqlite3.OperationalError) -> None:
+        if self._conn.in_transaction:
+            self._conn.execute("ROLLBACK")
+        self._store.failing = str(exc)
+        raise StoreUnavailable(f"the store cannot write: {exc}; nothing was kept") from exc

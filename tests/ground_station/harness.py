@@ -92,6 +92,7 @@ class Harness:
     def advance(self, seconds: float) -> None:
         """Move the clock and run the watchdog."""
         self.now += seconds
+        self.manager.retry_unsaved()
         self.manager.on_fleet_changes(self.monitor.check(self.now))
         self.settle()
 
