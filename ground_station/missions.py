@@ -23,8 +23,9 @@ from ground_station.action_book import ActionBook
 from ground_station.agent_reports import AgentReports
 from ground_station.event_log import EventLog
 from ground_station.fleet_monitor import Change, FleetMonitor
+from ground_station.fleet_state import AIRBORNE
 from ground_station.lifecycle import TERMINAL, TRANSITIONS, ActionEvent
-from ground_station.monitor_bearings import as_requested, with_bearing
+from ground_station.monitor_bearings import as_requested, moved_off, with_bearing
 from ground_station.plan_worker import PlanWorker
 from ground_station.replan_jobs import Computed, Job, ReplanOutcome
 from ground_station.replanner import Replanner
@@ -33,10 +34,7 @@ from ground_station.validation import validate
 from proto.errors import RequestError
 from proto.events import EventKind
 from proto.mission import ActionRecord, ActionState, DeliverAction, MonitorAction
-from proto.plan import (
-    MonitorTask,
-    Plan,
-)
+from proto.plan import MonitorTask, Plan, WaitTask
 from proto.rpc import (
     ActionList,
     ActionReply,
@@ -279,17 +277,42 @@ class MissionManager:
 
     def _void_segments(self, uav_id: str) -> None:
         """A lost UAV's monitoring assignments end with the loss: its later
-        segments get new ids, so its late report of the old ones is stale."""
+        segments get new ids, so its late report of the old ones is stale.
+        Lost in the air, it may hover on at the slot it held or was waiting
+        for (a hung agent's autopilot holds its last target): that slot is
+        moved clear of it (:func:`monitor_bearings.moved_off`)."""
         plan = self.replanner.plans.get(uav_id)
         watched = {t.action_id for t in plan.tasks if isinstance(t, MonitorTask)} if plan else set()
+        held = self._held_slot(uav_id, plan)
         for action_id in sorted(a for a in watched if a is not None):
             record = self.store.action(action_id)
-            if self.book.in_force(record):
-                assert record is not None
-                segments = {**record.segments, uav_id: record.segments.get(uav_id, 0) + 1}
-                self.book.save(
-                    msgspec.structs.replace(record, segments=segments), record.state, "UAV lost"
-                )
+            if not self.book.in_force(record):
+                continue
+            assert record is not None
+            segments = {**record.segments, uav_id: record.segments.get(uav_id, 0) + 1}
+            updated = msgspec.structs.replace(record, segments=segments)
+            if held is not None and held.action_id == action_id:
+                updated = moved_off(updated, held.slot, self.in_force())
+            self.book.save(updated, record.state, "UAV lost")
+
+    def _held_slot(self, uav_id: str, plan: Plan | None) -> MonitorTask | None:
+        """The monitoring task ``uav_id`` was flying (or waiting in the air
+        for) when it was last heard, if it is in the air."""
+        telemetry, status = self.monitor.telemetry(uav_id), self.monitor.status(uav_id)
+        if plan is None or status is None or telemetry is None:
+            return None
+        if telemetry.flight_state not in AIRBORNE:
+            return None
+        ids = [t.task_id for t in plan.tasks]
+        if status.task_id not in ids:
+            return None
+        at = ids.index(status.task_id)
+        for task in plan.tasks[at : at + 2]:  # the task, or the one a wait holds for
+            if isinstance(task, MonitorTask):
+                return task
+            if not isinstance(task, WaitTask):
+                return None
+        return None
 
     def retry_unplaced(self) -> None:
         """Replan every ``RETRY_UNPLACED_S`` mission seconds while an action

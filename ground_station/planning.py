@@ -18,6 +18,7 @@ from collections.abc import Iterable
 import msgspec
 
 from ground_station import planner as pl
+from ground_station.monitor_bearings import task_bearing
 from proto.fleet import Fleet
 from proto.geo import Point
 from proto.mission import ActionRecord, DeliverAction, InspectAction, MonitorAction
@@ -298,7 +299,7 @@ def _simple_task(
                 slots=action.uavs,
                 standoff_m=action.standoff_m,
                 height_m=safety.monitor_height_m,
-                bearing_deg=action.bearing_deg or 0.0,
+                bearing_deg=task_bearing(record, step.index),
                 duration_s=max(0.001, step.end_s - step.arrive_s),
                 **times,
             )
@@ -372,5 +373,6 @@ def _same_task(a: Task, b: Task) -> bool:
         return (
             abs(a.end_s - b.end_s) <= SAME_SEGMENT_S
             and abs(starts[0] - starts[1]) <= SAME_SEGMENT_S
+            and a.bearing_deg == b.bearing_deg  # a slot moved: its UAV must hear it
         )
     return True

@@ -35,6 +35,7 @@ class AgentConfig:
     pick_height_m: float = 1.0  # height above a tool station to grab / return a tool
     deliver_height_m: float = 2.0  # height above the worker to release a tool
     follow_threshold_m: float = 0.5  # re-target the slot when it moved more than this
+    route_margin_m: float = 1.0  # a route passes people by their clearance plus this
     handover_hold_m: float = 3.0  # a relief holds this much farther out until its window begins
     goto_resend_s: float = 1.0  # repeat a position target this often (no ACK exists)
     task_attempts: int = 3  # a task whose subtree failed this often is reported failed

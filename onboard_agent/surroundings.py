@@ -36,6 +36,11 @@ class Surroundings:
         worker = self.site.worker(worker_id)
         return worker.position if worker is not None else None
 
+    def people(self) -> list[Point]:
+        """Where every worker of the site is (tracked, else as the site says)."""
+        known = [self.worker_position(w.id) for w in self.site.workers]
+        return [p for p in known if p is not None]
+
     def station(self, station_id: str) -> ChargingStation | None:
         return self.site.station(station_id)
 

@@ -79,7 +79,9 @@ class ActionRecord(Record, frozen=True, kw_only=True):
     inspected, so a split inspection resumes) and ``monitored_s`` (seconds of
     monitoring already covered). ``segments`` counts the monitoring segments
     each UAV has ended, so that a later segment gets a new task id and is
-    never mistaken for the one already flown.
+    never mistaken for the one already flown. ``slot_bearings_deg`` holds
+    the monitoring slots moved off their place on the ring (slot -> its
+    bearing in degrees) because a UAV lost in the air there may hover on.
     """
 
     action_id: Id
@@ -93,3 +95,4 @@ class ActionRecord(Record, frozen=True, kw_only=True):
     waypoints_done: list[int] = []
     monitored_s: NonNegative = 0.0
     segments: dict[str, int] = {}
+    slot_bearings_deg: dict[int, float] = {}

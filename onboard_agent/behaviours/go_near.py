@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from onboard_agent import route
 from onboard_agent.autopilot.errors import CommandDenied, CommandTimeout
 from onboard_agent.autopilot.protocol import GUIDED
 from onboard_agent.behaviours.base import AgentBehaviour, CommandSlot, Status
@@ -20,9 +21,10 @@ class GoNear(AgentBehaviour):
     On the ground: wait until the autopilot reports it can arm (GPS fix, EKF,
     home, pre-arm checks; at most ``ready_timeout_s``), then GUIDED, arm,
     take off to ``takeoff_alt_m``, each command acknowledged before the next.
-    In the air: GUIDED if needed, then the position target, re-sent every
-    ``goto_resend_s`` and whenever the target moved more than
-    ``follow_threshold_m`` (a walking worker).
+    In the air: GUIDED if needed, then the position target (or, where the
+    straight line passes near a person, the next leg round them: see
+    :mod:`onboard_agent.route`), re-sent every ``goto_resend_s`` and
+    whenever it moved more than ``follow_threshold_m`` (a walking worker).
 
     A refused or unanswered mode change, arm or takeoff is retried after a
     backoff (``retry_backoff_s``, doubling up to ``retry_backoff_max_s``), up
@@ -146,10 +148,12 @@ class GoNear(AgentBehaviour):
             self.feedback_message = "setting GUIDED"
             return Status.RUNNING
         now = ctx.clock()
-        moved = self._sent is None or self._sent.distance_to(point) > config.follow_threshold_m
+        clear_m = ctx.surroundings.site.safety.people_clearance_m + config.route_margin_m
+        leg = route.next_leg(vehicle.position, point, ctx.surroundings.people(), clear_m)
+        moved = self._sent is None or self._sent.distance_to(leg) > config.follow_threshold_m
         if moved or now - self._sent_at >= config.goto_resend_s:
-            ctx.autopilot.goto(point)
-            self._sent, self._sent_at = point, now
+            ctx.autopilot.goto(leg)
+            self._sent, self._sent_at = leg, now
         distance = self.target.distance(ctx, point)
         self.feedback_message = f"flying to {self.target.label}, {distance:.1f} m"
         return Status.RUNNING

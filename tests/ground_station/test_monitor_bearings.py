@@ -3,11 +3,21 @@ two of them never send UAVs to one point."""
 
 from __future__ import annotations
 
+import msgspec
 import pytest
 
 from ground_station.monitor_bearings import choose_bearing, slot_bearings
-from proto import ModifyAction, MonitorAction, MonitorTask, SubmitAction
+from proto import (
+    AgentState,
+    AgentStatus,
+    FlightState,
+    ModifyAction,
+    MonitorAction,
+    MonitorTask,
+    SubmitAction,
+)
 from proto.errors import RequestError
+from tests.ground_station.harness import ALL
 
 
 def watch(k: int = 1, bearing: float | None = None, worker: str = "W2") -> MonitorAction:
@@ -28,7 +38,8 @@ def watch(k: int = 1, bearing: float | None = None, worker: str = "W2") -> Monit
     ],
 )
 def test_the_bearing_chosen_is_farthest_from_the_other_slots(others, k, expected):
-    assert choose_bearing(watch(k), others) == expected
+    taken = [b for other in others for b in slot_bearings(other)]
+    assert choose_bearing(watch(k), taken) == expected
 
 
 def test_slots_follow_the_bearing_round_the_ring():
@@ -68,3 +79,51 @@ def test_an_operator_bearing_is_kept_and_a_modify_keeps_the_chosen_one(gs):
     submit(gs, watch(), "m2")
     gs.manager.modify(ModifyAction(request_id="edit", action_id="m2", action=watch(k=2)))
     assert gs.store.action("m2").action.bearing_deg == 225.0
+
+
+def _slot_of(task: MonitorTask) -> float:
+    return (task.bearing_deg + 360.0 * task.slot / task.slots) % 360.0
+
+
+def _watching(gs, action_id: str) -> list[MonitorTask]:
+    return [
+        t
+        for p in gs.replanner.plans.values()
+        for t in p.tasks
+        if isinstance(t, MonitorTask) and t.action_id == action_id
+    ]
+
+
+@pytest.mark.parametrize(("k", "airborne"), [(1, True), (2, True), (1, False)])
+def test_a_slot_whose_uav_was_lost_in_the_air_is_moved_clear_of_it(gs, k, airborne):
+    """A hung agent's autopilot hovers on at its slot: the replacement is
+    sent to a slot the farthest from it (and from the action's other slots);
+    a UAV lost on the ground leaves the slot where it is."""
+    submit(gs, watch(k), "m1")
+    [held, *_] = [t for t in _watching(gs, "m1") if t.slot == 0]
+    victim = next(u for u, p in gs.replanner.plans.items() if held in p.tasks)
+    flying = gs.telemetry(victim)
+    if airborne:
+        flying = msgspec.structs.replace(flying, flight_state=FlightState.FLYING)
+    gs.monitor.on_telemetry(flying, gs.now)
+    gs.monitor.on_status(
+        AgentStatus(uav_id=victim, stamp_s=gs.now, state=AgentState.BUSY, task_id=held.task_id)
+    )
+    others = [u for u in ALL if u != victim]
+    gs.monitor.on_token(victim, False, gs.now)
+    gs.advance(6.0)
+    gs.heartbeat(*others)
+    gs.advance(0.1)
+    after = _watching(gs, "m1")
+    replacement = [t for t in after if t.slot == 0]
+    assert replacement and victim not in {
+        u for u, p in gs.replanner.plans.items() if replacement[0] in p.tasks
+    }
+    moved = _slot_of(replacement[0])
+    if not airborne:
+        assert moved == _slot_of(held)
+        return
+    expected = 180.0 if k == 1 else 90.0  # k = 2: clear of the lost UAV and of slot 1
+    assert moved == expected
+    assert sorted({_slot_of(t) for t in after}) == sorted({expected, *([180.0] if k == 2 else [])})
+    assert gs.store.action("m1").slot_bearings_deg == {0: expected}

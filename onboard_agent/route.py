@@ -1,0 +1,51 @@
+"""How a UAV flies to a target without passing near a person.
+
+The autopilot flies to a position target, but not along a straight 3-D
+line: it climbs or sinks more slowly than it moves across, so a line that
+clears a worker on paper can pass at head height. A route whose ground
+track passes within the clearance (the site's people clearance plus a
+margin) of a worker below its height band is therefore flown in legs that
+are each level or vertical: climb where the UAV is to a height that clears
+every such worker, fly level to above the target, then go straight down to
+it. Targets are themselves placed clear of people (slots beside them,
+drops above them); a worker the target is beside, such as the one a tool
+is dropped to, is passed at the target's height or higher."""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Iterable
+
+from proto.geo import Point
+
+TOLERANCE_M = 0.3
+"""This close (vertically to the crossing height, horizontally to above the
+target) a leg counts as flown."""
+
+
+def ground_distance(p: Point, a: Point, b: Point) -> float:
+    """Shortest horizontal distance from ``p`` to the ground track ``a``-``b``."""
+    dx, dy = b.x_m - a.x_m, b.y_m - a.y_m
+    length2 = dx * dx + dy * dy
+    along = (p.x_m - a.x_m) * dx + (p.y_m - a.y_m) * dy
+    t = 0.0 if length2 == 0 else max(0.0, min(1.0, along / length2))
+    return math.hypot(a.x_m + t * dx - p.x_m, a.y_m + t * dy - p.y_m)
+
+
+def next_leg(here: Point, target: Point, people: Iterable[Point], clear_m: float) -> Point:
+    """The point to send the autopilot now on the way from ``here`` to ``target``."""
+    low = min(here.z_m, target.z_m)
+    near = [
+        p for p in people if ground_distance(p, here, target) < clear_m and low < p.z_m + clear_m
+    ]
+    if not near:
+        return target
+    beside_target = [p for p in near if ground_distance(p, target, target) < clear_m]
+    crossing = max(
+        [here.z_m, target.z_m] + [p.z_m + clear_m for p in near if p not in beside_target]
+    )
+    if here.z_m < crossing - TOLERANCE_M:
+        return Point(x_m=here.x_m, y_m=here.y_m, z_m=crossing)
+    if math.hypot(target.x_m - here.x_m, target.y_m - here.y_m) > TOLERANCE_M:
+        return Point(x_m=target.x_m, y_m=target.y_m, z_m=crossing)
+    return target

@@ -1,0 +1,90 @@
+"""Routes never pass near a person: a ground track that would is flown
+over them in level and vertical legs (climb, across, down), and a target
+placed beside a person on purpose (a drop above a worker) is still reached."""
+
+from __future__ import annotations
+
+import itertools
+import math
+
+import pytest
+
+from onboard_agent import AgentConfig
+from onboard_agent.route import ground_distance, next_leg
+from proto.telemetry import FlightState
+from tests.onboard_agent.helpers import SCENARIO, Rig, point
+
+W2 = SCENARIO.site.worker("W2").position  # (-5, 15, 3)
+CLEARANCE_M = SCENARIO.site.safety.people_clearance_m
+CLEAR_M = CLEARANCE_M + AgentConfig().route_margin_m
+
+
+def test_a_clear_line_is_flown_straight():
+    assert next_leg(point(0, 0, 5), point(10, 0, 5), [W2], CLEAR_M) == point(10, 0, 5)
+    high = point(-20, 15, 9)  # over W2 by more than the clearance all the way
+    assert next_leg(point(0, 15, 9), high, [W2], CLEAR_M) == high
+
+
+def test_a_track_over_a_person_climbs_then_crosses_level_then_goes_down():
+    here, target = point(10, 10, 3), point(-9, 15, 6)  # the far slot, across W2
+    assert ground_distance(W2, here, target) < CLEAR_M
+    up = next_leg(here, target, [W2], CLEAR_M)
+    assert up == point(10, 10, 6)  # the target's height clears W2 by 3 m
+    across = next_leg(up, target, [W2], CLEAR_M)
+    assert across == target
+    low = point(-10, 10, 2.5)  # a pad approach: below W2's clearance band
+    assert next_leg(point(-1, 15, 6), low, [W2], CLEAR_M) == point(-10, 10, 6)
+    assert next_leg(point(-10, 10, 6), low, [W2], CLEAR_M) == low  # straight down
+
+
+def test_a_target_placed_beside_a_person_is_reached_from_above():
+    drop = point(W2.x_m, W2.y_m, W2.z_m + 1.5)  # a tool dropped 1.5 m above W2
+    start = point(5, 5, 3)  # lower than the drop: climb first, never at head height
+    assert next_leg(start, drop, [W2], CLEAR_M) == point(5, 5, drop.z_m)
+    assert next_leg(point(5, 5, drop.z_m), drop, [W2], CLEAR_M) == drop
+
+
+def _closest(path: list, person) -> float:
+    """Closest approach of a path flown leg by leg, each leg level or vertical
+    or straight (sampled every 10 cm)."""
+    best = math.inf
+    for a, b in itertools.pairwise(path):
+        n = max(1, int(a.distance_to(b) / 0.1))
+        for i in range(n + 1):
+            t = i / n
+            q = (
+                a.x_m + t * (b.x_m - a.x_m),
+                a.y_m + t * (b.y_m - a.y_m),
+                a.z_m + t * (b.z_m - a.z_m),
+            )
+            best = min(best, math.dist(q, (person.x_m, person.y_m, person.z_m)))
+    return best
+
+
+W3 = SCENARIO.site.worker("W3").position  # (5, 20, 3), between C2 and its east side
+
+
+@pytest.mark.parametrize(
+    ("start", "crosses"),
+    [(point(7, 21, 5), True), (point(8, 20, 4), True), (point(-1, 15, 6), False)],
+)
+def test_the_flight_to_a_station_from_beside_a_worker_keeps_the_clearance(start, crosses):
+    """The link is lost beside a worker: the emergency flight to the nearest
+    station (across the worker for the first two) never passes nearer any
+    worker than the clearance."""
+    rig = Rig(position=start, config=AgentConfig(agent_link_timeout_s=1.0))
+    rig.autopilot.update(flight_state=FlightState.FLYING, mode="GUIDED", armed=True)
+    rig.agent.ground_station("gs", False)
+    path = [start]
+
+    def flown() -> bool:
+        here = rig.autopilot.state.position
+        if here != path[-1]:
+            path.append(here)
+        return rig.autopilot.state.landed
+
+    station = rig.agent.ctx.surroundings.nearest_station(start).position
+    assert (ground_distance(W3, start, station) < CLEARANCE_M) == crosses
+    rig.run_until(flown, max_ticks=400)
+    assert min(_closest(path, w) for w in (W2, W3)) >= CLEARANCE_M, path
+    assert (path[-1].x_m, path[-1].y_m) == (station.x_m, station.y_m)
