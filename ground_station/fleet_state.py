@@ -10,10 +10,12 @@ from ground_station.fleet_monitor import FleetMonitor
 from ground_station.planning import UavNow
 from proto.plan import DeliverTask, GoHomeTask, MonitorTask, Plan, Task
 from proto.scenario import Scenario
-from proto.telemetry import FlightState
+from proto.site import ChargingStation
+from proto.spots import spot_positions
+from proto.telemetry import FlightState, Telemetry
 
 ON_PAD_M = 1.0
-"""A landed UAV this close (horizontally) to a station is on its pad."""
+"""A landed UAV this close (horizontally) to a spot of a station is on it."""
 
 AIRBORNE = frozenset({FlightState.FLYING, FlightState.TAKING_OFF, FlightState.LANDING})
 
@@ -28,10 +30,12 @@ def uavs_now(
         telemetry = monitor.telemetry(spec.id)
         home = site.station(spec.home_station)
         capacity = fleet.type_of(spec.id).battery_wh
+        docked = station_under(scenario, telemetry)
+        where = telemetry.position if telemetry else home.position
         uavs.append(
             UavNow(
                 uav_id=spec.id,
-                position=telemetry.position if telemetry else home.position,
+                position=docked.position if docked is not None else where,
                 energy_wh=min(capacity, telemetry.battery_wh) if telemetry else capacity,
                 available=monitor.available(spec.id),
                 airborne=bool(telemetry and telemetry.flight_state in AIRBORNE),
@@ -68,11 +72,18 @@ def drop_done_home(
     telemetry = monitor.telemetry(uav_id)
     if len(tasks) != 1 or not isinstance(tasks[0], GoHomeTask) or telemetry is None:
         return tasks
-    station = scenario.site.station(tasks[0].station_id)
+    station = station_under(scenario, telemetry)
+    return [] if station is not None and station.id == tasks[0].station_id else tasks
+
+
+def station_under(scenario: Scenario, telemetry: Telemetry | None) -> ChargingStation | None:
+    """The station a landed UAV sits on a spot of, if any: the planner,
+    whose stations are points, sees it at the station's position."""
+    if telemetry is None or telemetry.flight_state != FlightState.LANDED:
+        return None
     p = telemetry.position
-    on_pad = (
-        telemetry.flight_state == FlightState.LANDED
-        and station is not None
-        and math.hypot(p.x_m - station.position.x_m, p.y_m - station.position.y_m) <= ON_PAD_M
-    )
-    return [] if on_pad else tasks
+    for station in scenario.site.stations:
+        for spot in spot_positions(station, scenario.fleet):
+            if math.hypot(p.x_m - spot.x_m, p.y_m - spot.y_m) <= ON_PAD_M:
+                return station
+    return None

@@ -22,6 +22,7 @@ from onboard_agent.context import Context
 from onboard_agent.emergency import Emergency
 from onboard_agent.energy import EnergyModel
 from onboard_agent.mission import Mission, PlanVerdict
+from onboard_agent.spots import Spots
 from onboard_agent.surroundings import Surroundings
 from proto.errors import LinecrewError
 from proto.plan import Plan
@@ -62,6 +63,7 @@ class Agent:
             autopilot=autopilot,
             mission=Mission(uav_id, scenario.site, wall),
             surroundings=Surroundings(scenario.site),
+            spots=Spots(uav_id, scenario),
             energy=energy,
             clock=clock,
             wall=wall,

@@ -1,6 +1,6 @@
 """The agent on the bus: plan in (epoch-fenced by the mission), human poses
-in, ground-station liveliness in, telemetry / status / outcomes out, and its
-own liveliness token.
+and the stations' spot feeds in, ground-station liveliness in, telemetry /
+status / outcomes and spot claims out, and its own liveliness token.
 
 After every (re)appearance of a ground-station token the current plan is
 queried (``GetPlans`` on the plan key), because samples published during an
@@ -16,9 +16,10 @@ import logging
 from linecrew.bus import Bus
 from onboard_agent.agent import Agent
 from proto.errors import LinecrewError
-from proto.keys import KeySpace, Role
+from proto.keys import KeySpace, Role, UavTopic
 from proto.plan import Plan
 from proto.rpc import GetPlans, PlansReply
+from proto.spots import StationSpots
 from proto.telemetry import HumanPose
 
 log = logging.getLogger(__name__)
@@ -43,6 +44,7 @@ class Comms:
             async with asyncio.TaskGroup() as group:
                 group.create_task(self._plans())
                 group.create_task(self._poses())
+                group.create_task(self._spots())
                 group.create_task(self._ground_stations())
                 group.create_task(self._telemetry())
 
@@ -55,6 +57,12 @@ class Comms:
         async with self.bus.subscribe_async(self.keys.all_human_poses(), HumanPose) as sub:
             async for _key, pose in sub:
                 self.agent.human_pose(pose)
+
+    async def _spots(self) -> None:
+        async with self.bus.subscribe_async(self.keys.all_station_spots(), StationSpots) as sub:
+            async for key, feed in sub:
+                if self.keys.parse(key).ident == feed.station_id:  # trusted as far as its key
+                    self.agent.ctx.spots.update(feed, self.agent.ctx.clock())
 
     async def _ground_stations(self) -> None:
         key = self.keys.all_alive(Role.GROUND_STATION)
@@ -97,6 +105,9 @@ class Comms:
         if changed or now - self._last_status_at >= self.config.status_period_s:
             self.bus.publish(self.keys.status(self.uav_id), status)
             self._last_status_at = now
+        claim = self.agent.ctx.spots.claim_due(self.agent.ctx.clock())
+        if claim is not None:
+            self.bus.publish(self.keys.uav(self.uav_id, UavTopic.SPOT), claim)
         if self.agent.emergency.link_up:
             for outcome in self.agent.mission.take_outcomes():
                 self.bus.publish(self.keys.outcome(self.uav_id), outcome)

@@ -15,6 +15,7 @@ from onboard_agent.autopilot.protocol import Autopilot, VehicleState
 from onboard_agent.config import AgentConfig
 from onboard_agent.energy import EnergyModel
 from onboard_agent.mission import Mission
+from onboard_agent.spots import Spots
 from onboard_agent.surroundings import Surroundings
 
 
@@ -27,6 +28,7 @@ class Context:
     autopilot: Autopilot
     mission: Mission
     surroundings: Surroundings
+    spots: Spots
     energy: EnergyModel
     clock: Callable[[], float]  # monotonic mission seconds: task durations (scaled by speed-up)
     wall: Callable[[], float]  # mission seconds: plan times (WaitTask.until_s)

@@ -19,9 +19,11 @@ from onboard_agent.config import AgentConfig
 from onboard_agent.context import Context
 from onboard_agent.energy import EnergyModel
 from onboard_agent.mission import Mission
+from onboard_agent.spots import Spots
 from onboard_agent.surroundings import Surroundings
-from proto.fleet import UavType
+from proto.fleet import Fleet, UavType
 from proto.geo import GeoPoint
+from proto.scenario import Scenario
 from proto.site import Site
 
 Behaviour = py_trees.behaviour.Behaviour
@@ -39,6 +41,7 @@ def exportable_tree() -> Behaviour:
         autopilot=None,  # type: ignore[arg-type]
         mission=Mission("uav", site, lambda: 0.0),
         surroundings=Surroundings(site),
+        spots=Spots("uav", Scenario(name="any", site=site, fleet=Fleet(types=[uav_type], uavs=[]))),
         energy=EnergyModel(uav_type, 0.2),
         clock=lambda: 0.0,
         wall=lambda: 0.0,

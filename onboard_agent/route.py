@@ -9,7 +9,10 @@ are each level or vertical: climb where the UAV is to a height that clears
 every such worker, fly level to above the target, then go straight down to
 it. Targets are themselves placed clear of people (slots beside them,
 drops above them); a worker the target is beside, such as the one a tool
-is dropped to, is passed at the target's height or higher."""
+is dropped to, is passed at the target's height or higher. Flights to a
+station are legged the same way at the UAV's own height there (see
+:mod:`onboard_agent.spots`), so that UAVs heading for stations at once
+cross at different heights."""
 
 from __future__ import annotations
 
@@ -32,20 +35,29 @@ def ground_distance(p: Point, a: Point, b: Point) -> float:
     return math.hypot(a.x_m + t * dx - p.x_m, a.y_m + t * dy - p.y_m)
 
 
-def next_leg(here: Point, target: Point, people: Iterable[Point], clear_m: float) -> Point:
-    """The point to send the autopilot now on the way from ``here`` to ``target``."""
+def next_leg(
+    here: Point,
+    target: Point,
+    people: Iterable[Point],
+    clear_m: float,
+    cruise_z: float | None = None,
+) -> Point:
+    """The point to send the autopilot now on the way from ``here`` to
+    ``target``; with ``cruise_z`` the flight is legged anyway and crosses
+    at that height at least (a height of the UAV's own, clear of others)."""
     low = min(here.z_m, target.z_m)
     near = [
         p for p in people if ground_distance(p, here, target) < clear_m and low < p.z_m + clear_m
     ]
-    if not near:
+    if not near and cruise_z is None:
         return target
     beside_target = [p for p in near if ground_distance(p, target, target) < clear_m]
     crossing = max(
-        [here.z_m, target.z_m] + [p.z_m + clear_m for p in near if p not in beside_target]
+        [here.z_m, target.z_m, cruise_z or -math.inf]
+        + [p.z_m + clear_m for p in near if p not in beside_target]
     )
+    if math.hypot(target.x_m - here.x_m, target.y_m - here.y_m) <= TOLERANCE_M:
+        return target  # straight up or down to it
     if here.z_m < crossing - TOLERANCE_M:
         return Point(x_m=here.x_m, y_m=here.y_m, z_m=crossing)
-    if math.hypot(target.x_m - here.x_m, target.y_m - here.y_m) > TOLERANCE_M:
-        return Point(x_m=target.x_m, y_m=target.y_m, z_m=crossing)
-    return target
+    return Point(x_m=target.x_m, y_m=target.y_m, z_m=crossing)

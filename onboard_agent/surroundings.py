@@ -44,9 +44,12 @@ class Surroundings:
     def station(self, station_id: str) -> ChargingStation | None:
         return self.site.station(station_id)
 
-    def nearest_station(self, where: Point) -> ChargingStation | None:
-        """The charging station closest (horizontally) to ``where``."""
-        stations = self.site.stations
+    def nearest_station(
+        self, where: Point, among: list[ChargingStation] | None = None
+    ) -> ChargingStation | None:
+        """The charging station (of ``among``, else of the site) closest
+        (horizontally) to ``where``."""
+        stations = self.site.stations if among is None else among
         if not stations:
             return None
         return min(stations, key=lambda s: horizontal_distance(s.position, where))

@@ -15,6 +15,7 @@ from onboard_agent.context import Context
 from onboard_agent.surroundings import horizontal_distance
 from proto.geo import Point
 from proto.plan import DeliverTask, GoHomeTask, InspectTask, MonitorTask, PickTask, RechargeTask
+from proto.site import ChargingStation
 
 
 @dataclasses.dataclass(frozen=True)
@@ -26,6 +27,8 @@ class Target:
     radius_m: Callable[[Context], float]
     horizontal: bool = False
     settle: bool = False  # near only once hovering (to grab, release or land)
+    cleared: Callable[[Context], bool] = lambda _ctx: True  # may the UAV go on once near?
+    cruise_z: Callable[[Context], float | None] = lambda _ctx: None  # height to cross at
 
     def distance(self, ctx: Context, point: Point) -> float:
         here = ctx.vehicle.position
@@ -37,7 +40,7 @@ class Target:
             return False
         near = self.distance(ctx, point) <= self.radius_m(ctx)
         slow = ctx.vehicle.speed_mps <= ctx.config.settle_speed_mps
-        return near and (slow or not self.settle)
+        return near and (slow or not self.settle) and self.cleared(ctx)
 
 
 def _above(point: Point, height_m: float) -> Point:
@@ -117,19 +120,61 @@ def return_point(ctx: Context) -> Point | None:
     return _above(station.position, ctx.config.pick_height_m) if station is not None else None
 
 
-def task_station(ctx: Context) -> Point | None:
-    """Above the station of the head recharge / go-home task."""
+def _landing(ctx: Context, station: ChargingStation) -> Point:
+    """Above the spot of ``station`` granted to this UAV; above its hold
+    point while the claim waits for the grant (see :mod:`onboard_agent.spots`)."""
+    spot = ctx.spots.landing_point(station, ctx.clock())
+    if spot is None:
+        return ctx.spots.hold_point(station, ctx.config.approach_alt_m)
+    return _above(spot, ctx.config.approach_alt_m)
+
+
+def _task_station(ctx: Context) -> ChargingStation | None:
     task = ctx.mission.head
     if not isinstance(task, RechargeTask | GoHomeTask):
         return None
-    station = ctx.surroundings.station(task.station_id)
-    return _above(station.position, ctx.config.approach_alt_m) if station is not None else None
+    return ctx.surroundings.station(task.station_id)
+
+
+def task_station(ctx: Context) -> Point | None:
+    """Above the landing spot, at the station of the head recharge / go-home task."""
+    station = _task_station(ctx)
+    return _landing(ctx, station) if station is not None else None
+
+
+def landing_station(ctx: Context) -> ChargingStation | None:
+    """Where to land off the plan (battery low, mission over, emergency): the
+    station granted already, else the nearest with room, else the nearest."""
+    stations = ctx.surroundings.site.stations
+    granted = [s for s in stations if ctx.spots.granted(s.id) is not None]
+    if granted:
+        return granted[0]
+    here = ctx.vehicle.position
+    roomy = [s for s in stations if ctx.spots.has_room(s.id)]
+    return ctx.surroundings.nearest_station(here, roomy or stations)
 
 
 def nearest_station(ctx: Context) -> Point | None:
-    """Above the charging station nearest to the UAV."""
-    station = ctx.surroundings.nearest_station(ctx.vehicle.position)
-    return _above(station.position, ctx.config.approach_alt_m) if station is not None else None
+    """Above a landing spot at :func:`landing_station`."""
+    station = landing_station(ctx)
+    return _landing(ctx, station) if station is not None else None
+
+
+def _cruise(ctx: Context, station: ChargingStation | None) -> float | None:
+    """Flights to a station cross at the UAV's own hold height there."""
+    if station is None:
+        return None
+    return ctx.spots.hold_point(station, ctx.config.approach_alt_m).z_m
+
+
+def _task_station_cleared(ctx: Context) -> bool:
+    station = _task_station(ctx)
+    return station is None or ctx.spots.cleared(station.id, ctx.clock())
+
+
+def _landing_station_cleared(ctx: Context) -> bool:
+    station = landing_station(ctx)
+    return station is None or ctx.spots.cleared(station.id, ctx.clock())
 
 
 WAYPOINT = Target("WP", waypoint, lambda c: c.config.near_waypoint_m)
@@ -137,7 +182,19 @@ HUMAN_SLOT = Target("Human Target", monitor_slot, lambda c: c.config.near_slot_m
 HUMAN_DROP = Target("Human Target", drop_point, lambda c: c.config.near_human_m, settle=True)
 TOOL_STATION = Target("Station", pick_point, lambda c: c.config.near_tool_station_m, settle=True)
 TOOL_RETURN = Target("Station", return_point, lambda c: c.config.near_tool_station_m, settle=True)
-TASK_STATION = Target("Charging Station", task_station, lambda c: c.config.near_station_m, True)
+TASK_STATION = Target(
+    "Charging Station",
+    task_station,
+    lambda c: c.config.near_station_m,
+    horizontal=True,
+    cleared=_task_station_cleared,
+    cruise_z=lambda c: _cruise(c, _task_station(c)),
+)
 NEAREST_STATION = Target(
-    "Charging Station", nearest_station, lambda c: c.config.near_station_m, True
+    "Charging Station",
+    nearest_station,
+    lambda c: c.config.near_station_m,
+    horizontal=True,
+    cleared=_landing_station_cleared,
+    cruise_z=lambda c: _cruise(c, landing_station(c)),
 )

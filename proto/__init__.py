@@ -93,6 +93,7 @@ from proto.site import (
     Tower,
     Worker,
 )
+from proto.spots import SpotClaim, StationSpots, spot_positions
 from proto.telemetry import (
     AgentState,
     AgentStatus,
@@ -185,6 +186,8 @@ __all__ = [
     "SimFault",
     "SimState",
     "Site",
+    "SpotClaim",
+    "StationSpots",
     "SubmitAction",
     "Task",
     "TaskOutcome",
@@ -207,4 +210,5 @@ __all__ = [
     "check_id",
     "decode",
     "encode",
+    "spot_positions",
 ]

@@ -2,8 +2,9 @@
 
 ::
 
-    linecrew/{site}/uav/{uav}/telemetry|status|outcome|plan
+    linecrew/{site}/uav/{uav}/telemetry|status|outcome|plan|spot
     linecrew/{site}/human/{worker}/pose
+    linecrew/{site}/station/{station}/spots
     linecrew/{site}/gs/rpc/{op}
     linecrew/{site}/gs/events
     linecrew/{site}/alive/{role}/{id}
@@ -34,6 +35,7 @@ class UavTopic(enum.StrEnum):
     STATUS = "status"
     OUTCOME = "outcome"
     PLAN = "plan"
+    SPOT = "spot"
 
 
 class Role(enum.StrEnum):
@@ -54,9 +56,10 @@ def check_id(value: str, what: str = "id") -> str:
 
 
 class ParsedKey(msgspec.Struct, frozen=True):
-    """A key split into its parts: ``kind`` is ``uav``, ``human``, ``rpc``,
-    ``events``, ``alive`` or ``sim``; ``ident`` the UAV / worker / op / id;
-    ``topic`` the per-UAV topic, the liveliness role, or the sim topic."""
+    """A key split into its parts: ``kind`` is ``uav``, ``human``,
+    ``station``, ``rpc``, ``events``, ``alive`` or ``sim``; ``ident`` the UAV /
+    worker / station / op / id; ``topic`` the per-UAV topic, the liveliness
+    role, or the sim topic."""
 
     site: str
     kind: str
@@ -103,6 +106,14 @@ class KeySpace:
         """Wildcard for every worker's pose."""
         return f"{self.prefix}/human/*/pose"
 
+    def station_spots(self, station_id: str) -> str:
+        """``station/{station_id}/spots``."""
+        return f"{self.prefix}/station/{check_id(station_id, 'station id')}/spots"
+
+    def all_station_spots(self) -> str:
+        """``station/*/spots``."""
+        return f"{self.prefix}/station/*/spots"
+
     def rpc(self, op: str) -> str:
         """The ground-station queryable for request ``op``."""
         return f"{self.prefix}/gs/rpc/{check_id(op, 'rpc op')}"
@@ -134,6 +145,8 @@ class KeySpace:
                 return ParsedKey(self.site, "uav", check_id(uav_id, "uav id"), topic)
             case ["human", worker_id, "pose"]:
                 return ParsedKey(self.site, "human", check_id(worker_id, "worker id"), "pose")
+            case ["station", station_id, "spots"]:
+                return ParsedKey(self.site, "station", check_id(station_id, "station id"), "spots")
             case ["gs", "rpc", op]:
                 return ParsedKey(self.site, "rpc", check_id(op, "rpc op"))
             case ["gs", "events"]:

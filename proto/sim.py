@@ -101,7 +101,7 @@ class SafetyViolation(Record, frozen=True, kw_only=True):
     ``kind``: ``ground_contact`` (touched the ground while flying, away from a
     controlled landing: a crash), ``off_pad_landing`` (landed away from every
     charging pad), ``people_proximity`` (airborne within the site's
-    ``people_clearance_m`` of a worker), ``separation`` (two airborne UAVs
+    ``people_clearance_m`` of a worker), ``separation`` (two UAVs, one at least airborne,
     closer than ``separation_m``). One record each time a condition begins.
     """
 

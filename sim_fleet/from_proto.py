@@ -82,7 +82,11 @@ def scenario_from_proto(
         ),
         stations=tuple(
             StationSpec(
-                id=s.id, position=_vec(s.position), pads=s.pads, recharge=_recharge(s.recharge)
+                id=s.id,
+                position=_vec(s.position),
+                pads=s.pads,
+                recharge=_recharge(s.recharge),
+                spots=tuple(_vec(p) for p in proto.spot_positions(s, fleet)),
             )
             for s in site.stations
         ),

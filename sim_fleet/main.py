@@ -1,7 +1,8 @@
 """``linecrew sim``: the fleet simulator process.
 
 N simulated multirotors, each a MAVLink endpoint on ``base_port + i`` (like
-ArduCopter SITL), the simulated human tracker, fault injection (queries on
+ArduCopter SITL), the simulated human tracker, the charging stations' spot
+controllers (:mod:`sim_fleet.spot_control`), fault injection (queries on
 ``sim/fault``) and the ground truth (queries on ``sim/state``), all on one
 asyncio loop. Health: the ``alive/sim/{id}`` token.
 """
@@ -22,6 +23,7 @@ from proto.sim import GetSimState, SimFault
 from sim_fleet.faults import apply_fault
 from sim_fleet.fleet import Fleet, FleetConfig
 from sim_fleet.from_proto import scenario_from_proto
+from sim_fleet.spot_control import SpotControl, SpotService
 from sim_fleet.streams import TelemetryRates
 from sim_fleet.tracker import HumanTracker
 from sim_fleet.truth import sim_state
@@ -48,11 +50,15 @@ async def serve(
         "simulating %d UAVs at x%g", len(fleet.endpoints), speedup, extra={"ports": fleet.ports}
     )
     tracker = HumanTracker(scenario.site, world, bus)
+    spots = {s.id: s.spot_points for s in fleet.world.scenario.stations}
+    stations = SpotService(SpotControl(spots, world.rules.dock_radius_m), world, bus, keys)
     async with asyncio.TaskGroup() as group:
         running = group.create_task(fleet.run())
         poses = group.create_task(tracker.run(pose_hz))
+        spot_feed = group.create_task(stations.run(pose_hz))
         await shutdown.wait_async()
         poses.cancel()
+        spot_feed.cancel()
         fleet.stop()
         await running
     return 0

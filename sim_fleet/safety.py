@@ -7,8 +7,9 @@
   (horizontally) from every station;
 - ``people_proximity``: an airborne vehicle closer than ``people_clearance_m``
   (3-D) to a worker, debounced per (vehicle, worker); ``detail`` is the worker;
-- ``separation``: two airborne vehicles closer than ``separation_m`` (3-D),
-  debounced per pair, recorded under the lower id; ``detail`` is the other id.
+- ``separation``: two vehicles, at least one airborne, closer than
+  ``separation_m`` (3-D: a landing onto a taken spot counts), debounced per
+  pair, recorded under the lower id; ``detail`` is the other id.
 
 A condition that stays true (hovering next to a worker) is one record; it
 begins again once it has ended (moved away, landed).
@@ -67,9 +68,9 @@ class SafetyMonitor:
 
     def check(self, vehicles: Iterable[Vehicle], workers: dict[str, Vec3], time_s: float) -> None:
         """Distances after a physics step: people proximity and separation."""
-        flying = [v for v in vehicles if v.airborne]
-        self._people(flying, workers, time_s)
-        self._separation(flying, time_s)
+        vehicles = list(vehicles)
+        self._people([v for v in vehicles if v.airborne], workers, time_s)
+        self._separation(vehicles, time_s)
 
     def _people(self, flying: list[Vehicle], workers: dict[str, Vec3], time_s: float) -> None:
         clearance = self.rules.people_clearance_m
@@ -82,15 +83,17 @@ class SafetyMonitor:
                         self._record(PEOPLE_PROXIMITY, v, time_s, wid)
         self._near_people = near
 
-    def _separation(self, flying: list[Vehicle], time_s: float) -> None:
+    def _separation(self, vehicles: list[Vehicle], time_s: float) -> None:
         sep = self.rules.separation_m
         close: set[tuple[str, str]] = set()
         # sweep along x: only pairs less than ``sep`` apart in x can be too close
-        flying.sort(key=lambda v: v.position[0])
-        for i, a in enumerate(flying):
-            for b in flying[i + 1 :]:
+        vehicles.sort(key=lambda v: v.position[0])
+        for i, a in enumerate(vehicles):
+            for b in vehicles[i + 1 :]:
                 if b.position[0] - a.position[0] >= sep:
                     break
+                if not (a.airborne or b.airborne):
+                    continue  # two on the ground: side by side on a station
                 if math.dist(a.position, b.position) < sep:
                     lo, hi = (a, b) if a.id < b.id else (b, a)
                     close.add((lo.id, hi.id))

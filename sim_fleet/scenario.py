@@ -83,6 +83,12 @@ class StationSpec:
     position: Vec3
     pads: int = 1
     recharge: RechargeModel | None = None
+    spots: tuple[Vec3, ...] = ()  # landing spots (proto.spots); none given: the position
+
+    @property
+    def spot_points(self) -> tuple[Vec3, ...]:
+        """Where UAVs land at this station."""
+        return self.spots or (self.position,)
 
 
 @dataclass(frozen=True, kw_only=True)

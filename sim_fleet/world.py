@@ -43,8 +43,11 @@ class World:
         self.time_s = 0.0
         self._pending_s = 0.0
         self.vehicles: dict[str, Vehicle] = {}
+        placed: dict[str, int] = {}  # UAVs put on each station's spots so far
         for i, spec in enumerate(scenario.vehicles):
-            home = scenario.station(spec.home_station).position
+            spots = scenario.station(spec.home_station).spot_points
+            n = placed[spec.home_station] = placed.get(spec.home_station, 0) + 1
+            home = spots[(n - 1) % len(spots)]
             self.vehicles[spec.id] = Vehicle(
                 spec, scenario.types[spec.type], sysid=first_sysid + i, home=home, params=params
             )
@@ -55,8 +58,8 @@ class World:
         self.workers: dict[str, Vec3] = {w.id: w.position for w in scenario.workers}
         self.deliveries: list[Delivery] = []
         self.drops: list[Drop] = []
-        pads = (s.position for s in scenario.stations)
-        self.safety = SafetyMonitor(scenario.safety, pads, self.rules.dock_radius_m)
+        spots = (p for s in scenario.stations for p in s.spot_points)
+        self.safety = SafetyMonitor(scenario.safety, spots, self.rules.dock_radius_m)
 
     @property
     def violations(self) -> list[Violation]:
@@ -93,7 +96,10 @@ class World:
                 for v in self.vehicles.values()
                 if v.state is FlightState.LANDED
                 and not v.armed
-                and physics.horizontal_distance(v.position, station.spec.position) <= dock_r
+                and any(
+                    physics.horizontal_distance(v.position, p) <= dock_r
+                    for p in station.spec.spot_points
+                )
             ]
             if not docked and not station.on_pads and not station.queue:
                 continue

@@ -149,7 +149,8 @@ class GoNear(AgentBehaviour):
             return Status.RUNNING
         now = ctx.clock()
         clear_m = ctx.surroundings.site.safety.people_clearance_m + config.route_margin_m
-        leg = route.next_leg(vehicle.position, point, ctx.surroundings.people(), clear_m)
+        people = ctx.surroundings.people()
+        leg = route.next_leg(vehicle.position, point, people, clear_m, self.target.cruise_z(ctx))
         moved = self._sent is None or self._sent.distance_to(leg) > config.follow_threshold_m
         if moved or now - self._sent_at >= config.goto_resend_s:
             ctx.autopilot.goto(leg)

@@ -15,6 +15,7 @@ from linecrew.client.gateway import GatewayError
 from linecrew.launch.local_run import LocalRun, RunOptions
 from linecrew.scenarios import load
 from proto import EventKind
+from proto.spots import spot_positions
 from tests.e2e.truth import TruthLog
 
 SPEEDUP = 10.0
@@ -227,3 +228,35 @@ def test_a_ground_station_frozen_4_s_mid_monitor_ends_with_the_monitor_completed
 
 def _at(sample, uav_id: str):
     return next(v.position for v in sample.state.vehicles if v.uav_id == uav_id)
+
+
+def test_emergency_landings_never_put_two_uavs_on_one_spot(truth):
+    """Three UAVs watch W3, beside C2 (2 pads): kill -9 the ground station.
+    Each agent's emergency lands it at the nearest station with a spot
+    granted to it: two on C2's two spots, the third elsewhere; never two
+    on one spot, never one on top of another."""
+    truth.submit(monitor("W3", 3, 200))
+    w3 = PAPER.site.worker("W3").position
+    truth.until(
+        "three UAVs watch W3",
+        lambda: len(truth.watching(truth.samples[-1], w3, 4.0, SAFETY.monitor_height_m)) == 3,
+        90,
+    )
+    ProcessFaults(truth.run).kill("ground-station")
+    truth.until(
+        "all three landed",
+        lambda: all(v.state == "landed" for v in truth.samples[-1].state.vehicles),
+        120,
+    )
+    spots = {s.id: spot_positions(s, PAPER.fleet) for s in PAPER.site.stations}
+    where = {}
+    for v in truth.samples[-1].state.vehicles:
+        station, spot = min(
+            ((sid, i) for sid, points in spots.items() for i in range(len(points))),
+            key=lambda k: math.dist(_xyz(v.position), _xyz(spots[k[0]][k[1]])),
+        )
+        assert math.dist(_xyz(v.position), _xyz(spots[station][spot])) < 1.0, v
+        where[v.uav_id] = (station, spot)
+    assert len(set(where.values())) == 3, where
+    assert sum(1 for station, _ in where.values() if station == "C2") == 2, where
+    assert not truth.violations("separation", "off_pad_landing", *UNSAFE)

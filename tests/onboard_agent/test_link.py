@@ -10,6 +10,7 @@ import pytest
 from onboard_agent import AgentConfig, CommandDenied, CommandTimeout
 from onboard_agent.autopilot.link import MavlinkLink
 from proto.geo import LocalFrame
+from proto.spots import spot_positions
 from proto.telemetry import FlightState
 from tests.onboard_agent.conftest import fast_scenario
 
@@ -53,7 +54,7 @@ def fly(fleet, uav_id: str, scenario) -> None:
 
 def test_guided_takeoff_goto_land_with_positions_in_the_site_frame(fleet):
     async def scenario(link):
-        c1 = SITE.station("C1").position
+        c1 = spot_positions(SITE.station("C1"), fast_scenario().fleet)[0]  # uav-1 sits on spot 0
         assert link.state.position.distance_to(c1) < 0.1
         assert link.state.landed and link.state.battery_fraction == 1.0
         await link.set_mode("GUIDED")

@@ -13,6 +13,7 @@ import pytest
 from onboard_agent import Agent, AgentConfig, CommandDenied
 from onboard_agent.autopilot.link import MavlinkLink
 from proto.geo import LocalFrame
+from proto.spots import spot_positions
 from proto.telemetry import AgentState, FlightState
 from sim_fleet import Fleet, FleetConfig, FleetThread
 from sim_fleet.from_proto import scenario_from_proto
@@ -52,7 +53,7 @@ def sim_time(fleet) -> float:
 
 
 def test_link_reports_position_and_battery_unknown_and_not_ready_until_warmed_up(warming):
-    c1 = SITE.station("C1").position
+    c1 = spot_positions(SITE.station("C1"), SCENARIO.fleet)[0]  # uav-1 sits on spot 0
 
     async def main() -> dict:
         link = MavlinkLink(url(warming), LocalFrame(SITE.origin), CONFIG)

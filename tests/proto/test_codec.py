@@ -20,6 +20,8 @@ MESSAGE_TYPES = [
     proto.AgentStatus,
     proto.TaskOutcome,
     proto.HumanPose,
+    proto.SpotClaim,
+    proto.StationSpots,
     proto.Plan,
     proto.GsEvent,
     proto.Site,

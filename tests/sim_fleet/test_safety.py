@@ -93,7 +93,7 @@ def test_landing_away_from_every_station_is_an_off_pad_landing():
 
 
 def test_people_proximity_once_per_approach_and_only_airborne():
-    w = world(n=2)  # u2 stays landed at L1
+    w = world(n=2, homes=("S1", "L1"))  # u2 stays landed at L1
     v = w.vehicle("u1")
     airborne(w, v, 4.0)
     goto(w, v, (40.0, 0.0, 5.0))  # 2 m above W1 at (40, 0, 3): clear of 1.5 m
@@ -120,9 +120,11 @@ def test_separation_recorded_once_under_the_lower_id():
     goto(w, u2, (0.0, 0.0, 11.5))  # 1.5 m: clear again
     goto(w, u2, (0.0, 0.3, 10.5))
     assert kinds(w) == [("separation", "u1", "u2")] * 2
-    # u3 landed at L1: flying over it is no separation violation
-    goto(w, u1, (0.0, 50.0, 0.8))
+    # u3 landed at L1: coming down to 0.8 m above it is a near collision too
+    goto(w, u1, (0.0, 50.0, 3.0))
     assert len(w.violations) == 2
+    goto(w, u1, (0.0, 50.0, 0.8))
+    assert kinds(w)[2:] == [("separation", "u1", "u3")]
     assert u3.state is FlightState.LANDED
 
 
@@ -165,14 +167,16 @@ def test_pairwise_sweep_finds_exactly_the_close_pairs():
     for v in vehicles:
         v.state = FlightState.FLYING
         v.position = (rng.uniform(0, 10), rng.uniform(0, 10), rng.uniform(0, 3))
-    vehicles[0].state = FlightState.LANDED  # not airborne: never counted
+    landed = {vehicles[0].id, vehicles[1].id}  # two on the ground: never a pair
+    vehicles[0].state = vehicles[1].state = FlightState.LANDED
+    vehicles[1].position = (vehicles[0].position[0] + 0.5, *vehicles[0].position[1:])
     monitor = SafetyMonitor(SafetyRules(separation_m=1.0), [], 1.0)
     monitor.check(vehicles, {}, 0.0)
     found = {(v.vehicle_id, v.detail) for v in monitor.violations}
     want = {
         tuple(sorted((a.id, b.id)))
-        for a, b in itertools.combinations(vehicles[1:], 2)
-        if math.dist(a.position, b.position) < 1.0
+        for a, b in itertools.combinations(vehicles, 2)
+        if math.dist(a.position, b.position) < 1.0 and not {a.id, b.id} <= landed
     }
     assert found == want and len(found) == len(monitor.violations) > 0
     monitor.check(vehicles, {}, 0.05)  # nothing moved: nothing new

@@ -93,8 +93,16 @@ def service_rules(name: str) -> list[dict]:
         return [
             rule("sim-serve", IN, ["declare_queryable", "reply"], ["sim/fault", "sim/state"]),
             rule("sim-serve-q", OUT, ["query"], ["sim/fault", "sim/state"]),
-            rule("sim-poses", IN, ["put", "delete"], ["human/*/pose"]),
-            rule("sim-poses-interest", OUT, ["declare_subscriber"], ["human/*/pose"]),
+            rule("sim-poses", IN, ["put", "delete"], ["human/*/pose", "station/*/spots"]),
+            rule(
+                "sim-poses-interest",
+                OUT,
+                ["declare_subscriber"],
+                ["human/*/pose", "station/*/spots"],
+            ),
+            # the stations' spot controllers hear claims from every UAV
+            rule("sim-claims", IN, ["declare_subscriber"], ["uav/*/spot"]),
+            rule("sim-claims-data", OUT, ["put", "delete"], ["uav/*/spot"]),
             rule("sim-token", IN, ["liveliness_token"], ["alive/sim/*"]),
             *health("sim", "alive/sim/*"),
         ]
@@ -120,9 +128,15 @@ def service_rules(name: str) -> list[dict]:
 
 def agent_rules(uav: str) -> list[dict]:
     """An onboard agent (onboard_agent/comms.py): publishes its own telemetry,
-    status and outcomes; reads its own plan (subscription and resync query),
-    the workers' poses and the ground stations' tokens; declares its token."""
-    own_out = [f"uav/{uav}/telemetry", f"uav/{uav}/status", f"uav/{uav}/outcome"]
+    status, outcomes and spot claims; reads its own plan (subscription and
+    resync query), the workers' poses, the stations' spots and the ground
+    stations' tokens; declares its token."""
+    own_out = [
+        f"uav/{uav}/telemetry",
+        f"uav/{uav}/status",
+        f"uav/{uav}/outcome",
+        f"uav/{uav}/spot",
+    ]
     plan = f"uav/{uav}/plan"
     # The router tells a client which subscribers match what it publishes, and
     # a client stops sending puts when it knows of none: "*-interest" rules let
@@ -137,10 +151,15 @@ def agent_rules(uav: str) -> list[dict]:
             f"{uav}-pub-interest",
             OUT,
             ["declare_subscriber"],
-            ["uav/*/telemetry", "uav/*/status", "uav/*/outcome"],
+            ["uav/*/telemetry", "uav/*/status", "uav/*/outcome", "uav/*/spot"],
         ),
-        rule(f"{uav}-sub", IN, ["declare_subscriber"], [plan, "human/*/pose"]),
-        rule(f"{uav}-sub-data", OUT, ["put", "delete"], [plan, "human/*/pose"]),
+        rule(f"{uav}-sub", IN, ["declare_subscriber"], [plan, "human/*/pose", "station/*/spots"]),
+        rule(
+            f"{uav}-sub-data",
+            OUT,
+            ["put", "delete"],
+            [plan, "human/*/pose", "station/*/spots"],
+        ),
         rule(f"{uav}-plan-query", IN, ["query"], [plan]),
         rule(f"{uav}-plan-reply", OUT, ["reply"], [plan]),
         rule(f"{uav}-gs-alive", IN, ["declare_liveliness_subscriber"], ["alive/gs/*"]),

@@ -1,0 +1,124 @@
+"""Where this UAV may land at a charging station: the spot the station's
+controller granted it (:mod:`proto.spots`), claimed from the spots its
+feed shows free; until the grant comes, a hold point above the station, at
+a height of its own (``approach_alt_m`` plus ``HOLD_STEP_M`` per place in
+the fleet), so that UAVs waiting for one station never meet; flights to a
+station cross at that height too. A station whose controller has not been
+heard is landed on at its position, as before there were spots; one not
+heard for ``STALE_S`` (the UAV is cut off) on the spot its last feed showed
+free, so that a partition never keeps a UAV in the air."""
+
+from __future__ import annotations
+
+import math
+
+from proto.geo import Point
+from proto.scenario import Scenario
+from proto.site import ChargingStation
+from proto.spots import SpotClaim, StationSpots, spot_positions
+
+HOLD_STEP_M = 2.0
+"""Height between the hold points of two UAVs of the fleet."""
+CLAIM_EVERY_S = 1.0
+"""A claim not granted yet is repeated this often (mission seconds)."""
+UNUSED_S = 5.0
+"""A grant the UAV has not flown to for this long is given back."""
+STALE_S = 10.0
+"""A station feed older than this (mission seconds) no longer gates landing."""
+
+
+class Spots:
+    """The stations' spot feeds and this UAV's claims."""
+
+    def __init__(self, uav_id: str, scenario: Scenario) -> None:
+        self.uav_id = uav_id
+        self.fleet = scenario.fleet
+        ids = [u.id for u in scenario.fleet.uavs]
+        self.place = ids.index(uav_id) if uav_id in ids else len(ids)
+        self._feeds: dict[str, StationSpots] = {}
+        self._wanted: tuple[str, int] | None = None
+        self._claimed: tuple[str | None, int] | None = None
+        self._claimed_s = -math.inf
+        self._used_s: dict[str, float] = {}
+        self._heard_s: dict[str, float] = {}
+
+    def update(self, feed: StationSpots, now_s: float) -> None:
+        """The newest feed of a station, heard at ``now_s`` (an older stamp is ignored)."""
+        known = self._feeds.get(feed.station_id)
+        if known is None or feed.stamp_s >= known.stamp_s:
+            self._feeds[feed.station_id] = feed
+            self._heard_s[feed.station_id] = now_s
+
+    def _live(self, station_id: str, now_s: float) -> bool:
+        heard = self._heard_s.get(station_id)
+        return heard is not None and now_s - heard <= STALE_S
+
+    def granted(self, station_id: str) -> int | None:
+        """The spot of ``station_id`` granted to this UAV, if any."""
+        feed = self._feeds.get(station_id)
+        if feed is None:
+            return None
+        return next((i for i, g in enumerate(feed.granted) if g == self.uav_id), None)
+
+    def has_room(self, station_id: str) -> bool:
+        """Whether this UAV can land at ``station_id`` now or after a claim."""
+        return station_id not in self._feeds or self._free(station_id) is not None
+
+    def cleared(self, station_id: str, now_s: float) -> bool:
+        """Whether this UAV may land at ``station_id`` now: granted, or its
+        controller unheard or silent for ``STALE_S``."""
+        return not self._live(station_id, now_s) or self.granted(station_id) is not None
+
+    def landing_point(self, station: ChargingStation, now_s: float) -> Point | None:
+        """Where to land at ``station``: the granted spot (or the station, if
+        its controller is unheard); None while a claim waits for its grant."""
+        self._used_s[station.id] = now_s
+        if station.id not in self._feeds:
+            return station.position
+        spot = self.granted(station.id)
+        free = self._free(station.id)
+        if spot is None and not self._live(station.id, now_s):
+            spot = free  # cut off from the controller: the spot last seen free
+            if spot is None:
+                return station.position
+        if spot is not None:
+            self._wanted = None
+            return spot_positions(station, self.fleet)[spot]
+        self._wanted = (station.id, free) if free is not None else None
+        return None
+
+    def hold_point(self, station: ChargingStation, approach_alt_m: float) -> Point:
+        """Where this UAV waits for a spot at ``station``."""
+        p = station.position
+        return Point(
+            x_m=p.x_m, y_m=p.y_m, z_m=p.z_m + approach_alt_m + HOLD_STEP_M * (1 + self.place)
+        )
+
+    def claim_due(self, now_s: float) -> SpotClaim | None:
+        """The claim to send now, if any: a wanted spot (again every
+        ``CLAIM_EVERY_S`` until granted), or giving back a grant unused for
+        ``UNUSED_S``."""
+        want: tuple[str | None, int] | None = self._wanted
+        if want is None:
+            stale = [
+                s
+                for s in self._feeds
+                if self.granted(s) is not None and now_s - self._used_s.get(s, now_s) > UNUSED_S
+            ]
+            want = (None, 0) if stale else None
+        if want is None:
+            return None
+        if want == self._claimed and now_s - self._claimed_s < CLAIM_EVERY_S:
+            return None
+        self._claimed, self._claimed_s = want, now_s
+        return SpotClaim(uav_id=self.uav_id, station_id=want[0], spot=want[1], stamp_s=now_s)
+
+    def _free(self, station_id: str) -> int | None:
+        feed = self._feeds[station_id]
+        mine = self.granted(station_id)
+        if mine is not None:
+            return mine
+        for i, (granted, landed) in enumerate(zip(feed.granted, feed.landed, strict=False)):
+            if granted is None and landed in (None, self.uav_id):
+                return i
+        return None

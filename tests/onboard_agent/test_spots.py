@@ -1,0 +1,103 @@
+"""Landing at a station with a spot controller: claim a free spot, hold at
+a height of one's own until it is granted, land on that spot only; an
+emergency goes to the nearest station with room."""
+
+from __future__ import annotations
+
+from onboard_agent.spots import STALE_S
+from proto.plan import RechargeTask
+from proto.spots import StationSpots, spot_positions
+from tests.onboard_agent.helpers import SCENARIO, Rig, plan, point
+
+C3 = SCENARIO.site.station("C3")
+C3_SPOTS = spot_positions(C3, SCENARIO.fleet)  # 2 pads: x 9 and 11
+
+
+def feed(station: str, granted: list, landed: list | None = None, stamp: float = 1.0):
+    return StationSpots(
+        station_id=station, stamp_s=stamp, granted=granted, landed=landed or [None] * len(granted)
+    )
+
+
+def test_a_recharge_claims_a_free_spot_holds_until_granted_then_lands_on_it():
+    rig = Rig(battery=0.5, position=point(0, 7, 3))
+    spots = rig.agent.ctx.spots
+    spots.update(feed("C3", [None, None], landed=["uav-3", None]), rig.clock())  # spot 0 taken
+    task = RechargeTask(task_id="r1", station_id="C3", position=C3.position, until_fraction=0.9)
+    rig.agent.offer_plan(plan(task))
+    rig.tick(60)
+    claim = spots.claim_due(rig.clock())  # what the comms layer sends
+    assert (claim.uav_id, claim.station_id, claim.spot) == ("uav-1", "C3", 1)
+    assert spots.claim_due(rig.clock()) is None  # just sent: not again at once
+    state = rig.autopilot.state
+    hold = spots.hold_point(C3, rig.agent.ctx.config.approach_alt_m)
+    assert not state.landed and state.position == hold  # waits above C3, clear of it
+    rig.clock.advance(1.0)
+    again = spots.claim_due(rig.clock())
+    assert (again.station_id, again.spot) == ("C3", 1)  # repeated until granted
+    spots.update(feed("C3", [None, "uav-1"], landed=["uav-3", None], stamp=2.0), rig.clock())
+    rig.run_until(lambda: rig.autopilot.state.landed)
+    landed = rig.autopilot.state.position
+    assert (landed.x_m, landed.y_m) == (C3_SPOTS[1].x_m, C3_SPOTS[1].y_m)
+
+
+def test_uavs_waiting_for_one_station_hold_at_heights_of_their_own():
+    holds = {
+        Rig(uav_id=u).agent.ctx.spots.hold_point(C3, 3.0).z_m for u in ("uav-1", "uav-2", "uav-3")
+    }
+    heights = sorted(holds)
+    assert len(heights) == 3 and heights[1] - heights[0] >= 2.0 and heights[2] - heights[1] >= 2.0
+
+
+def test_an_emergency_lands_at_the_nearest_station_with_room():
+    rig = Rig(position=point(9, 11, 5))  # right above C3, which is full
+    spots = rig.agent.ctx.spots
+    rig.autopilot.update(flight_state=rig.autopilot.state.flight_state.FLYING, armed=True)
+    rig.agent.ground_station("gs", False)
+    rig.clock.advance(10.0)
+    spots.update(feed("C3", ["uav-2", None], landed=[None, "uav-3"]), rig.clock())
+    spots.update(feed("C1", [None, None]), rig.clock())
+    spots.update(feed("C2", [None, None]), rig.clock())
+    rig.tick(5)
+    claim = spots.claim_due(rig.clock())
+    assert claim is not None and claim.station_id == "C2"  # C2 (0, 20) before C1 (-10, 10)
+
+
+def test_a_grant_not_flown_to_is_given_back():
+    rig = Rig()
+    spots = rig.agent.ctx.spots
+    spots.update(feed("C3", ["uav-1", None]), rig.clock())
+    spots.landing_point(C3, rig.clock())
+    assert spots.claim_due(rig.clock()) is None  # in use
+    rig.clock.advance(6.0)
+    release = spots.claim_due(rig.clock())
+    assert release is not None and release.station_id is None
+
+
+def test_cut_off_from_the_controller_it_lands_on_the_spot_last_seen_free():
+    """A partition must never keep a UAV in the air: once the feed is older
+    than STALE_S, the spot the last feed showed free is landed on."""
+    rig = Rig(battery=0.5, position=point(9, 14, 6))
+    spots = rig.agent.ctx.spots
+    spots.update(feed("C3", [None, None], landed=["uav-3", None]), rig.clock())
+    task = RechargeTask(task_id="r1", station_id="C3", position=C3.position, until_fraction=0.9)
+    rig.agent.offer_plan(plan(task))
+    rig.tick(20)
+    assert not rig.autopilot.state.landed  # holding: no grant yet
+    rig.clock.advance(STALE_S)
+    rig.run_until(lambda: rig.autopilot.state.landed)
+    landed = rig.autopilot.state.position
+    assert (landed.x_m, landed.y_m) == (C3_SPOTS[1].x_m, C3_SPOTS[1].y_m)
+
+
+def test_a_flight_to_a_station_crosses_at_the_uav_s_own_hold_height():
+    rig = Rig(uav_id="uav-2", position=point(0, 7, 4))
+    rig.autopilot.update(flight_state=rig.autopilot.state.flight_state.FLYING, armed=True)
+    task = RechargeTask(task_id="r1", station_id="C3", position=C3.position, until_fraction=0.9)
+    rig.agent.offer_plan(plan(task))
+    heights = set()
+    rig.run_until(
+        lambda: rig.autopilot.state.landed or heights.add(rig.autopilot.state.position.z_m)
+    )
+    hold = rig.agent.ctx.spots.hold_point(C3, rig.agent.ctx.config.approach_alt_m).z_m
+    assert hold in heights and max(heights) == hold
