@@ -129,17 +129,12 @@ def _landing(ctx: Context, station: ChargingStation) -> Point:
     return _above(spot, ctx.config.approach_alt_m)
 
 
-def _task_station(ctx: Context) -> ChargingStation | None:
+def task_station(ctx: Context) -> ChargingStation | None:
+    """The station of the head recharge / go-home task."""
     task = ctx.mission.head
     if not isinstance(task, RechargeTask | GoHomeTask):
         return None
     return ctx.surroundings.station(task.station_id)
-
-
-def task_station(ctx: Context) -> Point | None:
-    """Above the landing spot, at the station of the head recharge / go-home task."""
-    station = _task_station(ctx)
-    return _landing(ctx, station) if station is not None else None
 
 
 def landing_station(ctx: Context) -> ChargingStation | None:
@@ -154,27 +149,29 @@ def landing_station(ctx: Context) -> ChargingStation | None:
     return ctx.surroundings.nearest_station(here, roomy or stations)
 
 
-def nearest_station(ctx: Context) -> Point | None:
-    """Above a landing spot at :func:`landing_station`."""
-    station = landing_station(ctx)
-    return _landing(ctx, station) if station is not None else None
+def station_target(pick: Callable[[Context], ChargingStation | None]) -> Target:
+    """Above a landing spot at the station ``pick`` names: near once over
+    the spot granted to this UAV (or no controller gates it), flown to at
+    the UAV's own hold height there."""
 
+    def locate(ctx: Context) -> Point | None:
+        station = pick(ctx)
+        return _landing(ctx, station) if station is not None else None
 
-def _cruise(ctx: Context, station: ChargingStation | None) -> float | None:
-    """Flights to a station cross at the UAV's own hold height there."""
-    if station is None:
-        return None
-    return ctx.spots.hold_point(station, ctx.config.approach_alt_m).z_m
+    def cleared(ctx: Context) -> bool:
+        station = pick(ctx)
+        return station is None or ctx.spots.cleared(station.id, ctx.clock())
 
+    def cruise_z(ctx: Context) -> float | None:
+        station = pick(ctx)
+        if station is None:
+            return None
+        return ctx.spots.hold_point(station, ctx.config.approach_alt_m).z_m
 
-def _task_station_cleared(ctx: Context) -> bool:
-    station = _task_station(ctx)
-    return station is None or ctx.spots.cleared(station.id, ctx.clock())
+    def radius(ctx: Context) -> float:
+        return ctx.config.near_station_m
 
-
-def _landing_station_cleared(ctx: Context) -> bool:
-    station = landing_station(ctx)
-    return station is None or ctx.spots.cleared(station.id, ctx.clock())
+    return Target("Charging Station", locate, radius, True, cleared=cleared, cruise_z=cruise_z)
 
 
 WAYPOINT = Target("WP", waypoint, lambda c: c.config.near_waypoint_m)
@@ -182,19 +179,5 @@ HUMAN_SLOT = Target("Human Target", monitor_slot, lambda c: c.config.near_slot_m
 HUMAN_DROP = Target("Human Target", drop_point, lambda c: c.config.near_human_m, settle=True)
 TOOL_STATION = Target("Station", pick_point, lambda c: c.config.near_tool_station_m, settle=True)
 TOOL_RETURN = Target("Station", return_point, lambda c: c.config.near_tool_station_m, settle=True)
-TASK_STATION = Target(
-    "Charging Station",
-    task_station,
-    lambda c: c.config.near_station_m,
-    horizontal=True,
-    cleared=_task_station_cleared,
-    cruise_z=lambda c: _cruise(c, _task_station(c)),
-)
-NEAREST_STATION = Target(
-    "Charging Station",
-    nearest_station,
-    lambda c: c.config.near_station_m,
-    horizontal=True,
-    cleared=_landing_station_cleared,
-    cruise_z=lambda c: _cruise(c, landing_station(c)),
-)
+TASK_STATION = station_target(task_station)
+NEAREST_STATION = station_target(landing_station)
