@@ -21,9 +21,14 @@ AIRBORNE = frozenset({FlightState.FLYING, FlightState.TAKING_OFF, FlightState.LA
 
 
 def uavs_now(
-    scenario: Scenario, monitor: FleetMonitor, plans: dict[str, Plan], in_force: set[str]
+    scenario: Scenario,
+    monitor: FleetMonitor,
+    plans: dict[str, Plan],
+    in_force: set[str],
+    controlled: frozenset[str] = frozenset(),
 ) -> list[UavNow]:
-    """Every UAV of the fleet as of its latest telemetry (at home, full, if none)."""
+    """Every UAV of the fleet as of its latest telemetry (at home, full, if
+    none); one under an operator's command (``controlled``) takes no work."""
     site, fleet = scenario.site, scenario.fleet
     uavs = []
     for spec in fleet.uavs:
@@ -37,7 +42,7 @@ def uavs_now(
                 uav_id=spec.id,
                 position=docked.position if docked is not None else where,
                 energy_wh=min(capacity, telemetry.battery_wh) if telemetry else capacity,
-                available=monitor.available(spec.id),
+                available=monitor.available(spec.id) and spec.id not in controlled,
                 airborne=bool(telemetry and telemetry.flight_state in AIRBORNE),
                 tool=telemetry.tool if telemetry else None,
                 running_action=running_action(monitor, plans.get(spec.id), in_force),

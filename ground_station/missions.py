@@ -26,6 +26,7 @@ from ground_station.fleet_monitor import Change, FleetMonitor
 from ground_station.fleet_state import AIRBORNE
 from ground_station.lifecycle import TERMINAL, TRANSITIONS, ActionEvent
 from ground_station.monitor_bearings import as_requested, moved_off, with_bearing
+from ground_station.paging import page
 from ground_station.plan_worker import PlanWorker
 from ground_station.replan_jobs import Computed, Job, ReplanOutcome
 from ground_station.replanner import Replanner
@@ -39,6 +40,8 @@ from proto.rpc import (
     ActionList,
     ActionReply,
     CancelAction,
+    Command,
+    ControlUav,
     FleetReply,
     GetAction,
     GetFleet,
@@ -134,10 +137,15 @@ class MissionManager:
                 return ActionReply(record=self.cancel(request))
             case GetAction(action_id=action_id):
                 return ActionReply(record=self.book.record(action_id))
-            case ListActions(states=states):
-                return ActionList(records=self.store.actions(states))
+            case ListActions(states=states, limit=limit, cursor=cursor):
+                records = self.store.actions(states)
+                shown, more = page(records, lambda r: r.action_id, cursor, limit)
+                return ActionList(records=shown, next_cursor=more)
             case GetFleet():
-                return FleetReply(uavs=self.monitor.snapshot())
+                return self.fleet()
+            case ControlUav():
+                self.control(request)
+                return self.fleet()
             case GetPlans(uav_id=uav_id):
                 plans = self.replanner.plans
                 chosen = [plans[uav_id]] if uav_id in plans else [] if uav_id else plans.values()
@@ -145,6 +153,37 @@ class MissionManager:
             case GetHistory(after_seq=after, limit=limit):
                 return HistoryReply(events=self.store.events(after, limit))
         raise RequestError(f"unsupported request {type(request).__name__}")
+
+    def fleet(self) -> FleetReply:
+        """Every UAV's state, with the operator's command in force."""
+        control = self.replanner.control
+        uavs = [
+            msgspec.structs.replace(u, control=control.command(u.uav_id))
+            for u in self.monitor.snapshot()
+        ]
+        return FleetReply(uavs=uavs)
+
+    def control(self, request: ControlUav) -> None:
+        """An operator's command for one UAV (or all): its work is replanned
+        to the others at once, and it gets the command's task."""
+        if request.uav_id is not None and not self.monitor.known(request.uav_id):
+            raise RequestError(
+                f"no UAV {request.uav_id!r} in the fleet", code="not_found", field="uav_id"
+            )
+        targets = [request.uav_id] if request.uav_id else [u.id for u in self.scenario.fleet.uavs]
+        now = self.clock()
+        for uav_id in targets:
+            if request.command is not Command.RESUME and uav_id not in self._controlled():
+                self._void_segments(uav_id)  # a held UAV keeps its slot: others get another
+            self.replanner.control.order(uav_id, request.command, now)
+            self.replanner.resend(uav_id)
+            self.events.emit(
+                EventKind.UAV_CONTROL, uav_id=uav_id, detail=f"operator: {request.command}"
+            )
+        self.request_replan(f"operator: {request.command} {request.uav_id or 'all'}", stale=True)
+
+    def _controlled(self) -> frozenset[str]:
+        return self.replanner.control.controlled
 
     def plan_quality(self) -> dict[str, float | None]:
         """The live plan's objective (seconds: weight-averaged completion +

@@ -28,6 +28,7 @@ from ground_station.live_plan import (
     frozen_parts,
     frozen_tasks,
 )
+from ground_station.operator_control import OperatorControl
 from ground_station.planning import build_problem, monitor_starts, same_work, to_tasks
 from ground_station.replan_jobs import Computed, ImproveSettings, Job, ReplanOutcome, ReplanStats
 from ground_station.store import Store, StoreUnavailable
@@ -67,6 +68,7 @@ class Replanner:
         session_window_s: float = 10.0,
     ) -> None:
         self.scenario = scenario
+        self.control = OperatorControl(scenario)  # UAVs an operator took out of the plan
         self.store = store
         self.monitor = monitor
         self.events = events
@@ -117,6 +119,7 @@ class Replanner:
         """``task_id`` ended on ``uav_id``: drop it (and what preceded it) from
         the plan held for the UAV, as the agent dropped it from its queue. The
         epoch stays: the agent's queue and this plan still agree."""
+        self.control.finished(uav_id, task_id)
         plan = self.plans.get(uav_id)
         if plan is None:
             return
@@ -144,7 +147,9 @@ class Replanner:
             records=list(records),
             now_s=now_s,
             reason=reason,
-            uavs=uavs_now(self.scenario, self.monitor, self.plans, in_force),
+            uavs=uavs_now(
+                self.scenario, self.monitor, self.plans, in_force, self.control.controlled
+            ),
             starts=monitor_starts(self.plans.values()),
             version=self.version,
         )
@@ -197,9 +202,10 @@ class Replanner:
             self.events.emit(EventKind.FAULT, detail=detail)
             return ReplanOutcome(self.store.counter("epoch"), [], {}, 0.0)
         result, elapsed = computed.result, computed.elapsed_s
+        ordered = {u: order.tasks for u, order in self.control.orders.items()}
         new_tasks = {
             uav: drop_done_home(self.scenario, self.monitor, uav, tasks)
-            for uav, tasks in computed.tasks.items()
+            for uav, tasks in {**computed.tasks, **ordered}.items()
         }
         fleet = self.scenario.fleet
         changed_ids = [

@@ -31,6 +31,7 @@ COMMANDS: dict[str, tuple[str, str]] = {
     "gesture": ("linecrew.client.commands:gesture_main", "submit a crew gesture"),
     "actions": ("linecrew.client.commands:actions_main", "list actions"),
     "cancel": ("linecrew.client.commands:cancel_main", "cancel an action"),
+    "control": ("linecrew.client.commands:control_main", "hold / return / land / resume a UAV"),
     "status": ("linecrew.client.commands:status_main", "fleet table"),
     "plan": ("linecrew.client.commands:plan_main", "live plan timeline, or plan a PROBLEM file"),
     "events": ("linecrew.client.commands:events_main", "follow ground-station events"),

@@ -8,7 +8,7 @@ next inspection waypoint with its service time, the next
 leaves for a station when it must, and the ground station hands the slot
 over at the planned end), the leg to the tool station or the
 worker, the leg to the station of a recharge / go-home task, or hovering
-until a wait ends when airborne.
+until a wait ends when airborne (at most ``MONITOR_LOOKAHEAD_S`` of it).
 """
 
 from __future__ import annotations
@@ -27,7 +27,8 @@ from proto.plan import (
 )
 
 MONITOR_LOOKAHEAD_S = 30.0
-"""Monitoring seconds that must fit in the battery before (and while) watching."""
+"""Monitoring (or airborne waiting) seconds that must fit in the battery
+before and while doing it."""
 
 
 def available_wh(ctx: Context) -> float:
@@ -69,8 +70,8 @@ def step_wh(ctx: Context) -> tuple[float, Point]:
             station = ctx.surroundings.station(task.station_id)
             point = station.position if station is not None else here
             return energy.travel_wh(here, point), point
-        case WaitTask(until_s=until) if not ctx.vehicle.landed:
-            return energy.hover_wh(until - ctx.wall()), here
+        case WaitTask(until_s=until) if not ctx.vehicle.landed:  # a hold is no one step either
+            return energy.hover_wh(min(until - ctx.wall(), MONITOR_LOOKAHEAD_S)), here
     return 0.0, here
 
 

@@ -33,6 +33,7 @@ from proto.plan import (
     DeliverTask,
     GoHomeTask,
     InspectTask,
+    LandTask,
     MonitorTask,
     PickTask,
     RechargeTask,
@@ -125,6 +126,11 @@ def back_to_station(ctx: Context) -> Behaviour:
     return _subtree(Sequence("Back To Station", False, children), "BackToStation")
 
 
+def land_here(ctx: Context) -> Behaviour:
+    """Land Task (an operator's command): land where the UAV is."""
+    return _subtree(Sequence("Land Task", False, [Land(ctx)]), "LandTask")
+
+
 def perform_task(ctx: Context) -> Behaviour:
     """Perform Task Tree: the subtree for the head task's kind, guarded so a
     hopeless task is reported failed, then "Task Done"."""
@@ -135,6 +141,7 @@ def perform_task(ctx: Context) -> Behaviour:
         ("Recharge", (RechargeTask,), recharge_task),
         ("Wait", (WaitTask,), wait),
         ("Home", (GoHomeTask,), go_home),
+        ("Land", (LandTask,), land_here),
     ]
     children: list[Behaviour] = []
     for label, kinds, build in branches:

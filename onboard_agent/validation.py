@@ -12,6 +12,7 @@ from proto.plan import (
     DeliverTask,
     GoHomeTask,
     InspectTask,
+    LandTask,
     MonitorTask,
     PickTask,
     RechargeTask,
@@ -44,7 +45,7 @@ def task_problem(task: Task, site: Site) -> str | None:
             if site.station(station_id) is None:
                 return f"unknown station {station_id!r}"
             return None
-        case WaitTask():
+        case WaitTask() | LandTask():
             return None
     return f"unsupported task {type(task).__name__}"
 

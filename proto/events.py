@@ -22,6 +22,7 @@ class EventKind(enum.StrEnum):
     UAV_BACK = "uav_back"
     UAV_CRASHED = "uav_crashed"
     UAV_STATE = "uav_state"
+    UAV_CONTROL = "uav_control"
     FAULT = "fault"
 
 

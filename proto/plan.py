@@ -90,7 +90,20 @@ class GoHomeTask(TaskBase, frozen=True, kw_only=True, tag="home"):
     position: Point
 
 
-Task = InspectTask | MonitorTask | PickTask | DeliverTask | RechargeTask | WaitTask | GoHomeTask
+class LandTask(TaskBase, frozen=True, kw_only=True, tag="land"):
+    """Land where the UAV is (an operator's command; never planned)."""
+
+
+Task = (
+    InspectTask
+    | MonitorTask
+    | PickTask
+    | DeliverTask
+    | RechargeTask
+    | WaitTask
+    | GoHomeTask
+    | LandTask
+)
 
 
 class Plan(Message, frozen=True, kw_only=True):

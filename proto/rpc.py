@@ -61,10 +61,14 @@ class GetAction(RequestBase, frozen=True, kw_only=True, tag="get_action"):
 
 
 class ListActions(RequestBase, frozen=True, kw_only=True, tag="list_actions"):
-    """Actions, optionally only those in ``states``. Replies :class:`ActionList`."""
+    """Actions in creation order, optionally only those in ``states``, one
+    page at a time: at most ``limit`` (and what fits the bus), after the
+    action ``cursor`` names. Replies :class:`ActionList`."""
 
     op = "list_actions"
     states: list[ActionState] = []
+    limit: PositiveCount | None = None
+    cursor: Id | None = None
 
 
 class GetFleet(RequestBase, frozen=True, kw_only=True, tag="fleet"):
@@ -94,6 +98,28 @@ class GetMetrics(RequestBase, frozen=True, kw_only=True, tag="metrics"):
     op = "metrics"
 
 
+class Command(enum.StrEnum):
+    """What an operator orders a UAV to do, taking it out of the plan.
+
+    ``hold``: hover where it is (stay on the pad if landed); ``return``: fly
+    to its home station and land; ``land``: land where it is; ``resume``:
+    back under the planner."""
+
+    HOLD = "hold"
+    RETURN = "return"
+    LAND = "land"
+    RESUME = "resume"
+
+
+class ControlUav(RequestBase, frozen=True, kw_only=True, tag="control"):
+    """Take control of ``uav_id`` (None: every UAV, e.g. ``hold`` as a fleet
+    stop): its work goes to the others until ``resume``. Replies :class:`FleetReply`."""
+
+    op = "control"
+    uav_id: Id | None = None
+    command: Command
+
+
 Request = (
     SubmitAction
     | ModifyAction
@@ -104,6 +130,7 @@ Request = (
     | GetPlans
     | GetHistory
     | GetMetrics
+    | ControlUav
 )
 REQUEST_OPS: tuple[str, ...] = tuple(t.op for t in typing.get_args(Request))
 """The routing names of all requests, one queryable each."""
@@ -132,6 +159,8 @@ class UavState(Record, frozen=True, kw_only=True):
     """Seconds the UAV has been silent, while it is silent but within the
     link timeout (not yet lost); None when heard normally or already lost.
     Its tasks' fate is unknown meanwhile, not failed."""
+    control: Command | None = None
+    """The operator's command in force (None: the planner flies it)."""
 
 
 class ActionReply(Message, frozen=True, kw_only=True, tag="action"):
@@ -141,9 +170,10 @@ class ActionReply(Message, frozen=True, kw_only=True, tag="action"):
 
 
 class ActionList(Message, frozen=True, kw_only=True, tag="actions"):
-    """Action records."""
+    """Action records; ``next_cursor`` continues the list (None: it ended)."""
 
     records: list[ActionRecord]
+    next_cursor: Id | None = None
 
 
 class FleetReply(Message, frozen=True, kw_only=True, tag="fleet"):

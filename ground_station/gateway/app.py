@@ -11,27 +11,32 @@ from typing import Any
 
 import msgspec
 from fastapi import FastAPI, Request, Response
+from fastapi.exceptions import RequestValidationError
 from fastapi.responses import PlainTextResponse, StreamingResponse
+from starlette.exceptions import HTTPException
 
 from ground_station.gateway import console
-from ground_station.gateway.bodies import GestureBody, ModifyBody, SubmitEnvelope
+from ground_station.gateway.bodies import ControlBody, GestureBody, ModifyBody, SubmitEnvelope
 from ground_station.gateway.errors import (
     HttpError,
     decode_body,
     error_response,
+    http_error_handler,
     linecrew_error_handler,
+    validation_error_handler,
 )
 from ground_station.gateway.event_stream import event_stream
 from ground_station.gateway.gestures import Vocabulary
 from ground_station.gateway.metrics import GatewayCounters, prometheus_text
 from ground_station.gateway.rpc import GsClient, to_json
 from ground_station.gateway.settings import GatewaySettings
-from proto.errors import LinecrewError
+from proto.errors import LinecrewError, RequestTimeout
 from proto.mission import Action, ActionState
 from proto.rpc import (
     ActionList,
     ActionReply,
     CancelAction,
+    ControlUav,
     FleetReply,
     GetAction,
     GetFleet,
@@ -68,6 +73,8 @@ def create_app(
     )
     counters = GatewayCounters()
     app.add_exception_handler(LinecrewError, linecrew_error_handler)
+    app.add_exception_handler(HTTPException, http_error_handler)
+    app.add_exception_handler(RequestValidationError, validation_error_handler)
 
     @app.middleware("http")
     async def guard(request: Request, call_next: Callable[[Request], Awaitable[Response]]):
@@ -101,7 +108,15 @@ def create_app(
         request = SubmitAction(
             request_id=request_id or str(uuid.uuid4()), action=action, action_id=action_id
         )
-        reply = await client.call(request, ActionReply)
+        try:
+            reply = await client.call(request, ActionReply)
+        except RequestTimeout as exc:  # it may have been accepted: say how to find out
+            raise HttpError(
+                "request_timeout",
+                f"{exc.message}; the action may have been accepted: send the same request "
+                "again with this request_id (it is never accepted twice)",
+                request_id=request.request_id,
+            ) from exc
         return json(reply.record, 201)
 
     @app.post(
@@ -117,10 +132,27 @@ def create_app(
         request_id = envelope.request_id or request.headers.get("idempotency-key")
         return await submit(action, request_id, envelope.action_id)
 
-    @app.get("/v1/actions", summary="List actions, optionally by state")
-    async def list_actions(state: str | None = None) -> Response:
-        states = [ActionState(s) for s in state.split(",")] if state else []
-        return json((await client.call(ListActions(states=states), ActionList)).records)
+    @app.get("/v1/actions", summary="List actions, optionally by state, whole or by page")
+    async def list_actions(
+        state: str | None = None, limit: int | None = None, cursor: str | None = None
+    ) -> Response:
+        """Every action (pages fetched in turn), or with ``limit`` / ``cursor``
+        one page; the ``Next-Cursor`` header then continues it."""
+        states = _states(state)
+        if limit is not None and limit < 1:
+            raise HttpError("invalid_request", "limit must be >= 1", field="limit")
+        if limit is not None or cursor is not None:
+            request = ListActions(states=states, limit=limit, cursor=cursor)
+            reply = await client.call(request, ActionList)
+            headers = {"Next-Cursor": reply.next_cursor} if reply.next_cursor else {}
+            return Response(to_json(reply.records), media_type="application/json", headers=headers)
+        records, cursor = [], None
+        while True:
+            reply = await client.call(ListActions(states=states, cursor=cursor), ActionList)
+            records += reply.records
+            if reply.next_cursor is None:
+                return json(records)
+            cursor = reply.next_cursor
 
     @app.get("/v1/actions/{action_id}", summary="One action")
     async def get_action(action_id: str) -> Response:
@@ -160,6 +192,27 @@ def create_app(
     @app.get("/v1/fleet", summary="UAV states, batteries, positions, current tasks")
     async def fleet() -> Response:
         return json((await client.call(GetFleet(), FleetReply)).uavs)
+
+    async def control(request: Request, uav_id: str | None) -> Response:
+        command = decode_body(await body(request), ControlBody)
+        reply = await client.call(ControlUav(uav_id=uav_id, command=command.command), FleetReply)
+        return json(reply.uavs)
+
+    @app.post(
+        "/v1/uavs/{uav_id}/control",
+        summary="Take a UAV out of the plan: hold, return or land; resume gives it back",
+        openapi_extra=_body_schema(ControlBody),
+    )
+    async def control_uav(uav_id: str, request: Request) -> Response:
+        return await control(request, uav_id)
+
+    @app.post(
+        "/v1/fleet/control",
+        summary="Command every UAV at once (hold: a fleet stop; resume: back to the plan)",
+        openapi_extra=_body_schema(ControlBody),
+    )
+    async def control_fleet(request: Request) -> Response:
+        return await control(request, None)
 
     @app.get("/v1/plan", summary="Every UAV's timed steps (for a Gantt chart)")
     async def plan() -> Response:
@@ -220,10 +273,24 @@ def create_app(
     return app
 
 
-BODY_TYPES = (Action, ModifyBody, GestureBody, SimFault)
+BODY_TYPES = (Action, ModifyBody, GestureBody, ControlBody, SimFault)
 _SCHEMAS, _COMPONENTS = msgspec.json.schema_components(
     BODY_TYPES, ref_template="#/components/schemas/{name}"
 )
+
+
+def _states(text: str | None) -> list[ActionState]:
+    """``?state=a,b`` as action states; an unknown one is a 422 naming them."""
+    states = []
+    for name in text.split(",") if text else []:
+        try:
+            states.append(ActionState(name))
+        except ValueError:
+            known = ", ".join(ActionState)
+            raise HttpError(
+                "invalid_request", f"unknown state {name!r} (one of {known})", field="state"
+            ) from None
+    return states
 
 
 def _body_schema(body_type: Any) -> dict[str, Any]:

@@ -9,6 +9,7 @@ import msgspec
 from proto.base import Id
 from proto.geo import Point
 from proto.mission import Action
+from proto.rpc import Command
 
 Positive = Annotated[float, msgspec.Meta(gt=0)]
 
@@ -26,6 +27,12 @@ class ModifyBody(msgspec.Struct, frozen=True, kw_only=True, forbid_unknown_field
     priority: Positive | None = None
     action: Action | None = None
     request_id: str | None = None
+
+
+class ControlBody(msgspec.Struct, frozen=True, kw_only=True, forbid_unknown_fields=True):
+    """``POST /v1/uavs/{id}/control`` and ``POST /v1/fleet/control``."""
+
+    command: Command
 
 
 class GestureBody(msgspec.Struct, frozen=True, kw_only=True, forbid_unknown_fields=True):

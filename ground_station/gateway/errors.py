@@ -5,7 +5,9 @@ from __future__ import annotations
 
 import msgspec
 from fastapi import Request
+from fastapi.exceptions import RequestValidationError
 from fastapi.responses import JSONResponse
+from starlette.exceptions import HTTPException
 
 from proto.errors import LinecrewError
 
@@ -17,6 +19,7 @@ STATUS_BY_CODE: dict[str, int] = {
     "unknown_gesture": 422,
     "tool_out_of_stock": 422,
     "not_found": 404,
+    "method_not_allowed": 405,
     "conflict": 409,
     "invalid_transition": 409,
     "request_timeout": 503,
@@ -48,6 +51,25 @@ async def linecrew_error_handler(_request: Request, exc: Exception) -> JSONRespo
     assert isinstance(exc, LinecrewError)
     extra = getattr(exc, "extra", {})
     return error_response(exc.code, exc.message, getattr(exc, "field", None), **extra)
+
+
+async def http_error_handler(_request: Request, exc: Exception) -> JSONResponse:
+    """FastAPI's own 404 / 405 in the same shape as every other error."""
+    assert isinstance(exc, HTTPException)
+    code = {404: "not_found", 405: "method_not_allowed"}.get(exc.status_code, "http_error")
+    response = error_response(code, str(exc.detail))
+    response.status_code = exc.status_code
+    for name, value in (exc.headers or {}).items():
+        response.headers[name] = value
+    return response
+
+
+async def validation_error_handler(_request: Request, exc: Exception) -> JSONResponse:
+    """A bad path or query parameter: 422 naming it, in the same shape."""
+    assert isinstance(exc, RequestValidationError)
+    first = exc.errors()[0] if exc.errors() else {}
+    field = ".".join(str(p) for p in first.get("loc", ())[1:]) or None
+    return error_response("invalid_request", first.get("msg", "invalid request"), field)
 
 
 def decode_body(body: bytes, body_type: type) -> object:

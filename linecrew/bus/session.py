@@ -9,6 +9,7 @@ and watchers, and a clean close that undeclares everything.
 from __future__ import annotations
 
 import asyncio
+import contextlib
 import inspect
 import logging
 import time
@@ -22,7 +23,14 @@ from linecrew.bus.config import BusConfig
 from linecrew.bus.handoff import AsyncQueue
 from linecrew.bus.stats import BusStats
 from proto import codec
-from proto.errors import DecodeError, LinecrewError, RequestError, RequestTimeout, Unavailable
+from proto.errors import (
+    DecodeError,
+    EncodeError,
+    LinecrewError,
+    RequestError,
+    RequestTimeout,
+    Unavailable,
+)
 from proto.rpc import ErrorReply
 
 log = logging.getLogger(__name__)
@@ -227,6 +235,11 @@ class Bus:
                     query.reply_err(codec.encode(reply))
                 else:
                     query.reply(key, codec.encode(reply))
+            except EncodeError as exc:  # a reply too large (or absurd) still answers
+                log.warning("cannot encode the reply on %s: %s", key, exc)
+                error = ErrorReply(code=exc.code, message=f"the reply cannot be sent: {exc}")
+                with contextlib.suppress(zenoh.ZError):
+                    query.reply_err(codec.encode(error))
             except (zenoh.ZError, LinecrewError) as exc:
                 log.warning("cannot reply on %s: %s", key, exc)
 

@@ -9,6 +9,9 @@
 - ``below_reserve``: no vehicle (the simulator's truth) falls below the
   fleet's reserve fraction, unless a fault injected on it (battery fault,
   freeze, kill) made the reserve impossible: then it is reported as excused.
+- ``unsafe``: the simulator records no safety violation (two UAVs closer
+  than the separation, a UAV near a person, a landing off every spot, a
+  crash); a crash of a UAV a fault was injected on is reported as excused.
 - ``unfinished``: at the end every accepted action has completed or failed;
   ``failed_without_reason``: a failed action carries a reason.
 
@@ -54,6 +57,7 @@ class Checker:
         self._below: set[str] = set()  # UAVs currently below reserve (one report per episode)
         self._executing_twice: set[str] = set()  # task ids seen doubled on the last sample
         self._seen: set[tuple[str, str]] = set()  # (invariant, detail) already reported
+        self._unsafe_seen = 0  # the simulator's violations already judged
 
     # -- inputs ------------------------------------------------------------------
 
@@ -82,6 +86,7 @@ class Checker:
             self._check_executing(at_s, fleet)
         if truth is not None:
             self._check_reserve(at_s, truth)
+            self._check_safety(at_s, truth)
 
     def finish(self, at_s: float, actions: list[dict[str, Any]] | None) -> None:
         """The end-of-run checks on the final action list."""
@@ -177,6 +182,18 @@ class Checker:
                 )
             else:
                 self._violate(at_s, "below_reserve", where)
+
+    def _check_safety(self, at_s: float, truth: SimState) -> None:
+        self.checks["unsafe"] += 1
+        for v in truth.violations[self._unsafe_seen :]:
+            where = f"{v.kind} {v.uav_id} {v.detail} at sim {v.sim_time_s:.1f} s".replace("  ", " ")
+            if v.kind == "ground_contact" and self.excuses.get(v.uav_id):
+                self.excused.append(
+                    f"t={at_s:.1f} s {where}: excused by {', '.join(self.excuses[v.uav_id])}"
+                )
+            else:
+                self._violate(at_s, "unsafe", where)
+        self._unsafe_seen = max(self._unsafe_seen, len(truth.violations))
 
     def _violate(self, at_s: float, invariant: str, detail: str) -> None:
         if (invariant, detail) in self._seen:

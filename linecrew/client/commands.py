@@ -1,5 +1,5 @@
 """The operator commands of ``linecrew``: submit, gesture, actions, cancel,
-status, plan, events, fault. All go through the gateway over HTTP (which one:
+control, status, plan, events, fault. All go through the gateway over HTTP (which one:
 :mod:`linecrew.client.session`); ``--json``, anywhere on the command line,
 prints the raw answer instead of a table."""
 
@@ -26,6 +26,7 @@ from linecrew.client.render import (
 )
 from linecrew.client.session import NoRunError, Target, resolve
 from linecrew.fault_kinds import add_fault_arguments, fault_from_args
+from proto.rpc import Command
 
 GLOBAL_VALUED = ("--url", "--token")
 """Options of every operator command that take a value (hoisted like ``--json``)."""
@@ -196,6 +197,16 @@ def cancel_main(argv: list[str]) -> int:
         lambda g: g.call("DELETE", f"/v1/actions/{args.action_id}"),
         lambda r: actions_table([r]),
     )
+
+
+def control_main(argv: list[str]) -> int:
+    """``linecrew control UAV|all hold|return|land|resume``"""
+    parser = _parser("control", "take a UAV (or all) out of the plan, or give it back")
+    parser.add_argument("uav", help="a UAV id, or 'all' (hold all: a fleet stop)")
+    parser.add_argument("command", choices=[str(c) for c in Command])
+    args = _parse(parser, argv)
+    path = "/v1/fleet/control" if args.uav == "all" else f"/v1/uavs/{args.uav}/control"
+    return _run(args, lambda g: g.call("POST", path, json={"command": args.command}), fleet_table)
 
 
 def status_main(argv: list[str]) -> int:

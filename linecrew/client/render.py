@@ -37,9 +37,11 @@ def fleet_table(uavs: list[dict[str, Any]]) -> Table:
     for u in uavs:
         tel, status = u.get("telemetry") or {}, u.get("status") or {}
         pos = tel.get("position")
+        silent, control = u.get("silent_s"), u.get("control")
+        state = f"{u['state']} (silent {silent:.0f} s)" if silent else u["state"]
         table.add_row(
             u["uav_id"],
-            u["state"],
+            f"{state}, operator: {control}" if control else state,
             f"{100 * tel['battery_fraction']:.0f} %" if tel else "-",
             f"{pos['x_m']:.0f}, {pos['y_m']:.0f}, {pos['z_m']:.0f}" if pos else "-",
             status.get("task_id") or "-",

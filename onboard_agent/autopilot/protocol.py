@@ -10,7 +10,8 @@ acknowledged it, or with an :class:`~onboard_agent.autopilot.errors.AutopilotErr
 from __future__ import annotations
 
 import dataclasses
-from typing import Protocol
+from collections.abc import Callable
+from typing import Any, Protocol
 
 from proto.geo import GeoPoint, Point, Vector
 from proto.telemetry import FlightState
@@ -32,6 +33,8 @@ class Pending(Protocol):
     def exception(self) -> BaseException | None: ...
 
     def cancel(self) -> bool: ...
+
+    def add_done_callback(self, fn: Callable[[Any], object], /) -> None: ...
 
 
 EKF_NEEDED = 0x1 | 0x2 | 0x10 | 0x20  # EKF_STATUS_REPORT: attitude, horiz velocity, abs position

@@ -56,6 +56,8 @@ class CommandSlot:
         self.failed_label = ""  # what failed last
 
     def issue(self, label: str, pending: Pending) -> None:
+        if self._pending is not None:
+            _forget(self._pending)
         self.label, self._pending, self.error = label, pending, ""
         self.failed, self.failed_label = None, ""
 
@@ -80,7 +82,23 @@ class CommandSlot:
         return Status.SUCCESS
 
     def cancel(self) -> None:
-        if self._pending is not None and not self._pending.done():
-            self._pending.cancel()
+        if self._pending is not None:
+            _forget(self._pending)
         self._pending = None
         self.label = ""
+
+
+def _forget(pending: Pending) -> None:
+    """Drop a command nobody waits for any more (cancelled if still in
+    flight) without leaving an exception unretrieved ("Task exception was
+    never retrieved" in the agent's log)."""
+    if not pending.done():
+        pending.cancel()
+        pending.add_done_callback(_retrieve)
+    else:
+        _retrieve(pending)
+
+
+def _retrieve(pending: Pending) -> None:
+    if not pending.cancelled():
+        pending.exception()

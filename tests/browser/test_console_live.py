@@ -207,6 +207,25 @@ def test_a_priority_is_changed_and_an_action_cancelled_from_the_table(
     assert not log.errors, log.errors
 
 
+def test_an_operator_holds_a_uav_and_gives_it_back_from_the_fleet_table(
+    run, new_page, gateway, artefacts
+):
+    page, log = open_console(new_page, run)
+    wait_loaded(page)
+    uav = UAVS[0]
+    row = page.locator(f"#fleet tr[data-uav='{uav}']")
+    row.locator("button[data-command=hold]").click()
+    page.locator(f"#fleet tr[data-uav='{uav}'][data-control=hold]").wait_for()
+    assert row.locator("button[data-command=hold]").get_attribute("aria-pressed") == "true"
+    fleet = {u["uav_id"]: u for u in gateway.call("GET", "/v1/fleet")}
+    assert fleet[uav]["control"] == "hold"
+    shoot(page, artefacts, "held")
+    row.locator("button[data-command=resume]").click()
+    page.locator(f"#fleet tr[data-uav='{uav}'][data-control='']").wait_for()
+    assert {u["uav_id"]: u for u in gateway.call("GET", "/v1/fleet")}[uav]["control"] is None
+    assert not log.errors, log.errors
+
+
 def flying_with(gateway, action_id: str) -> str | None:
     """The UAV flying a task of ``action_id``, if any."""
     for uav in gateway.call("GET", "/v1/fleet"):

@@ -15,8 +15,10 @@ from linecrew.bus import Bus, BusConfig
 from proto import (
     AgentState,
     AgentStatus,
+    EventKind,
     GetFleet,
     GetHistory,
+    GsEvent,
     HistoryReply,
     KeySpace,
     RequestError,
@@ -160,6 +162,28 @@ def test_queryable_served_by_asyncio_in_process(two_buses):
         raise AssertionError("queryable never answered")
 
     assert asyncio.run(scenario()) == HistoryReply(events=[])
+
+
+def test_a_reply_too_large_for_the_bus_is_an_error_reply_not_silence(two_buses):
+    server, client = two_buses
+    huge = GsEvent(seq=1, stamp_s=0.0, kind=EventKind.FAULT, detail="x" * (2 << 20))
+
+    async def handler(_request: GetHistory) -> HistoryReply:
+        return HistoryReply(events=[huge])
+
+    async def scenario() -> RequestError:
+        with server.serve(KEYS.rpc("huge"), GetHistory, handler):
+            for _ in range(100):
+                try:
+                    await client.query_async(KEYS.rpc("huge"), GetHistory(), HistoryReply, 2.0)
+                except RequestTimeout:
+                    await asyncio.sleep(0.05)  # the queryable may not be routed yet
+                except RequestError as exc:
+                    return exc
+        raise AssertionError("no error reply")
+
+    error = asyncio.run(scenario())
+    assert error.code == "encode_error" and "cannot be sent" in error.message
 
 
 def test_liveliness_sees_a_killed_peer_disappear(bus_config, peer):

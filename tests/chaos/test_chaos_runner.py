@@ -10,6 +10,7 @@ import pytest
 from linecrew.chaos import Checker, main, make_schedule
 from linecrew.chaos.schedule import DISRUPTIONS
 from linecrew.scenarios import load
+from proto import Point, SafetyViolation, SimState
 
 PAPER = load("paper")
 SEED = 7
@@ -46,6 +47,29 @@ def test_the_checker_flags_a_lost_action_and_work_planned_twice():
     assert [v.invariant for v in checker.violations] == ["action_lost", "double_task"]
     checker.finish(2.0, [{"action_id": "a1", "state": "failed", "reason": ""}])
     assert checker.violations[-1].invariant == "failed_without_reason"
+
+
+def test_the_checker_flags_what_the_simulator_saw_as_unsafe_once_each():
+    checker = Checker(reserve_fraction=0.2)
+    checker.excuse("uav-3", "battery fault 0.05")
+    close = SafetyViolation(
+        kind="separation",
+        uav_id="uav-1",
+        sim_time_s=3.0,
+        position=Point(x_m=0, y_m=0),
+        detail="uav-2",
+    )
+    crash = SafetyViolation(
+        kind="ground_contact", uav_id="uav-3", sim_time_s=4.0, position=Point(x_m=0, y_m=0)
+    )
+    checker.sample(1.0, None, None, None, SimState(sim_time_s=3.0, speedup=1.0, violations=[close]))
+    truth = SimState(sim_time_s=4.0, speedup=1.0, violations=[close, crash])
+    checker.sample(2.0, None, None, None, truth)
+    checker.sample(3.0, None, None, None, truth)
+    assert [(v.invariant, v.detail) for v in checker.violations] == [
+        ("unsafe", "separation uav-1 uav-2 at sim 3.0 s")
+    ]
+    assert len(checker.excused) == 1 and "battery fault" in checker.excused[0]
 
 
 def test_a_short_seeded_run_reports_zero_violations(tmp_path, capsys):

@@ -260,3 +260,39 @@ def test_emergency_landings_never_put_two_uavs_on_one_spot(truth):
     assert len(set(where.values())) == 3, where
     assert sum(1 for station, _ in where.values() if station == "C2") == 2, where
     assert not truth.violations("separation", "off_pad_landing", *UNSAFE)
+
+
+def test_an_operator_holds_a_watching_uav_sends_it_home_and_gives_it_back(truth):
+    """Hold the UAV watching W2: it hovers where it is while another takes
+    over W2 on another side; return: it lands on a spot at home; resume:
+    the planner has it again. The monitor is flown to the end."""
+    watch = truth.submit(monitor("W2", 1, 200))["action_id"]
+
+    def on_station() -> set[str]:
+        return truth.watching(truth.samples[-1], W2, 4.0, SAFETY.monitor_height_m)
+
+    [held] = truth.until("a UAV watches W2", on_station, 60)
+    fleet = truth.gateway.call("POST", f"/v1/uavs/{held}/control", json={"command": "hold"})
+    assert {u["uav_id"]: u["control"] for u in fleet}[held] == "hold"
+    since = truth.samples[-1].sim_s
+    [relief] = truth.until("another UAV watches W2", lambda: on_station() - {held}, 90)
+    there = _xyz(_at(truth.samples[-1], held))
+    later = [s for s in truth.samples if s.sim_s > since + 3]
+    assert all(math.dist(_xyz(_at(s, held)), there) < 1.0 for s in later), "the held UAV moved"
+    assert math.dist(there, _xyz(_at(truth.samples[-1], relief))) > 3.0
+    truth.gateway.call("POST", f"/v1/uavs/{held}/control", json={"command": "return"})
+    home = PAPER.site.station(next(u.home_station for u in PAPER.fleet.uavs if u.id == held))
+    spots = [_xyz(p) for p in spot_positions(home, PAPER.fleet)]
+
+    def landed_home() -> bool:
+        v = next(v for v in truth.samples[-1].state.vehicles if v.uav_id == held)
+        return v.state == "landed" and min(math.dist(_xyz(v.position), p) for p in spots) < 1.0
+
+    truth.until("the held UAV landed at home", landed_home, 90)
+    fleet = truth.gateway.call("POST", f"/v1/uavs/{held}/control", json={"command": "resume"})
+    assert {u["uav_id"]: u["control"] for u in fleet}[held] is None
+    truth.until("the monitor ends", lambda: truth.finished(watch), 200)
+    assert truth.action(watch)["state"] == "completed", truth.action(watch)
+    controls = [e.detail for e in truth.events() if e.kind == EventKind.UAV_CONTROL]
+    assert controls == ["operator: hold", "operator: return", "operator: resume"]
+    assert not truth.violations("separation", *UNSAFE)

@@ -13,14 +13,20 @@ from proto import (
     AgentState,
     AgentStatus,
     CancelAction,
+    Command,
+    ControlUav,
     EventKind,
     FlightState,
+    GetFleet,
     InspectTask,
+    LandTask,
     ModifyAction,
     OutcomeResult,
     PickTask,
+    RequestError,
     SubmitAction,
     TaskOutcome,
+    WaitTask,
 )
 from tests.ground_station.harness import ALL, Harness
 
@@ -87,6 +93,16 @@ def test_modify_changes_priority_and_refuses_finished_actions(gs):
     gs.settle()
     with pytest.raises(Exception, match="cancelled"):
         gs.manager.modify(ModifyAction(request_id="m2", action_id="inspect-loop", priority=1))
+
+
+def _inspecting(gs, action_id: str) -> set[str]:
+    """The UAVs whose current plans inspect for ``action_id``."""
+    return {
+        p.uav_id
+        for p in gs.replanner.plans.values()
+        for t in p.tasks
+        if isinstance(t, InspectTask) and t.action_id == action_id
+    }
 
 
 def _inspect_task(gs, action_id: str):
@@ -229,3 +245,38 @@ def test_a_status_naming_a_finished_action_does_not_break_replanning(gs):
     refused = [e for e in gs.events if e.kind == EventKind.FAULT and "refused" in e.detail]
     assert refused == []
     assert gs.store.action("monitor-w2").state == ActionState.CANCELLED
+
+
+def test_an_operator_command_takes_a_uav_out_of_the_plan_until_resume(gs):
+    gs.submit("inspect-loop")
+    plan, _ = _inspect_task(gs, "inspect-loop")
+    held = plan.uav_id
+    gs.manager.handle(ControlUav(uav_id=held, command=Command.LAND))
+    gs.settle()
+    [land] = gs.latest(held).tasks
+    assert isinstance(land, LandTask)
+    assert _inspect_task(gs, "inspect-loop")[0].uav_id != held  # its work went to another
+    fleet = {u.uav_id: u for u in gs.manager.handle(GetFleet()).uavs}
+    assert fleet[held].control == Command.LAND
+    gs.manager.reports.on_outcome(
+        TaskOutcome(
+            uav_id=held,
+            task_id=land.task_id,
+            epoch=gs.latest(held).epoch,
+            result=OutcomeResult.COMPLETED,
+        )
+    )
+    gs.manager.request_replan("test")
+    gs.settle()
+    assert gs.replanner.plans[held].tasks == []  # landed: it waits for the operator
+    gs.manager.handle(ControlUav(command=Command.HOLD))  # every UAV: a fleet stop
+    gs.settle()
+    assert all(isinstance(gs.latest(u).tasks[0], WaitTask) for u in ALL)
+    assert not _inspecting(gs, "inspect-loop")
+    gs.manager.handle(ControlUav(command=Command.RESUME))
+    gs.settle()
+    assert {u.control for u in gs.manager.handle(GetFleet()).uavs} == {None}
+    assert _inspecting(gs, "inspect-loop")  # planned again
+    with pytest.raises(RequestError) as unknown:
+        gs.manager.handle(ControlUav(uav_id="uav-9", command=Command.HOLD))
+    assert unknown.value.code == "not_found"

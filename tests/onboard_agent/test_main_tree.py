@@ -2,8 +2,12 @@
 
 from __future__ import annotations
 
+import asyncio
+import gc
+
 import py_trees
 
+from onboard_agent.behaviours.base import CommandSlot
 from proto.telemetry import FlightState
 from tests.onboard_agent.helpers import SCENARIO, Rig, inspect_task, plan, point
 
@@ -70,3 +74,28 @@ def test_the_tree_never_finishes():
             py_trees.common.Status.SUCCESS,  # only via "Mission Over" (landed at a station)
         )
     assert rig.mission.head is None
+
+
+def test_a_command_dropped_after_it_failed_leaves_no_unretrieved_exception():
+    """A command the tree stops waiting for (cancelled, or replaced by the
+    next one) has its exception retrieved: asyncio never logs "Task
+    exception was never retrieved" for it."""
+
+    async def refused() -> None:
+        raise RuntimeError("denied")
+
+    async def main() -> list[dict]:
+        seen: list[dict] = []
+        asyncio.get_running_loop().set_exception_handler(lambda _loop, ctx: seen.append(ctx))
+        slot = CommandSlot()
+        slot.issue("arm", asyncio.ensure_future(refused()))
+        await asyncio.sleep(0.01)  # it failed; nobody checked
+        slot.issue("arm", asyncio.ensure_future(refused()))  # replaced
+        await asyncio.sleep(0.01)
+        slot.cancel()  # and dropped
+        await asyncio.sleep(0.01)
+        gc.collect()
+        await asyncio.sleep(0.01)
+        return seen
+
+    assert asyncio.run(main()) == []

@@ -115,3 +115,55 @@ def test_ground_station_down_gives_503_with_a_clear_message(gateway, gs):
     assert response.status_code == 503
     assert response.json()["error"] == "request_timeout"
     wait_until(lambda: gateway.get("/healthz").json()["ground_station"] == "down", 10, "down")
+    point = {"position": {"x_m": 0, "y_m": 7, "z_m": 3}}
+    refused = gateway.post("/v1/actions", json={"type": "inspect", "waypoints": [point]})
+    body = refused.json()
+    assert refused.status_code == 503 and body["error"] == "request_timeout"
+    assert body["request_id"] and "with this request_id" in body["message"]  # how to find out
+
+
+def test_a_list_larger_than_a_bus_message_is_served_whole_or_by_page(gateway):
+    """24 inspections of 900 waypoints are over 1 MiB on the bus: the list
+    still answers (fetched page by page), and by page with a cursor."""
+    points = [
+        {"position": {"x_m": -20 + (i % 40), "y_m": i // 40, "z_m": 5}, "service_s": 1}
+        for i in range(900)
+    ]
+    ids = []
+    for _ in range(24):
+        reply = gateway.post("/v1/actions", json={"type": "inspect", "waypoints": points})
+        assert reply.status_code == 201, reply.text
+        ids.append(reply.json()["action_id"])
+    whole = gateway.get("/v1/actions")
+    assert whole.status_code == 200 and [a["action_id"] for a in whole.json()] == ids
+    seen, cursor = [], None
+    while True:
+        params = {"limit": 5, **({"cursor": cursor} if cursor else {})}
+        page = gateway.get("/v1/actions", params=params)
+        assert page.status_code == 200 and 0 < len(page.json()) <= 5
+        seen += [a["action_id"] for a in page.json()]
+        cursor = page.headers.get("Next-Cursor")
+        if cursor is None:
+            break
+    assert seen == ids
+    bogus = gateway.get("/v1/actions", params={"state": "bogus"})
+    assert bogus.status_code == 422 and bogus.json()["field"] == "state"
+    unknown = gateway.get("/v1/actions", params={"cursor": "act-nope"})
+    assert unknown.status_code == 422 and unknown.json()["field"] == "cursor"
+
+
+@pytest.mark.parametrize(
+    ("method", "path", "params", "status", "error", "field"),
+    [
+        ("GET", "/v1/nowhere", {}, 404, "not_found", None),
+        ("PUT", "/v1/actions", {}, 405, "method_not_allowed", None),
+        ("GET", "/v1/actions", {"limit": "many"}, 422, "invalid_request", "limit"),
+    ],
+)
+def test_the_framework_s_own_errors_come_in_the_documented_shape(
+    gateway, method, path, params, status, error, field
+):
+    response = gateway.request(method, path, params=params)
+    body = response.json()
+    assert response.status_code == status and set(body) >= {"error", "message", "field"}, body
+    assert (body["error"], body["field"]) == (error, field) and "detail" not in body

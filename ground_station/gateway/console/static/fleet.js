@@ -1,9 +1,13 @@
-// The fleet table: one row per UAV, kept by id, cells updated in place.
+// The fleet table: one row per UAV, kept by id, cells updated in place;
+// its control cell takes a UAV out of the plan (hold, return, land) and
+// gives it back (resume); "hold all" above the table is a fleet stop.
 
-import { el, Keyed, pct, text, toggle } from "./dom.js";
-import { byId, currentTask, onRender, select } from "./store.js";
+import { api } from "./api.js";
+import { attr, el, Keyed, pct, text, toggle } from "./dom.js";
+import { byId, currentTask, onRender, select, setFleet } from "./store.js";
 
-const COLUMNS = ["uav", "state", "flight", "battery", "alt", "heading", "task", "epoch"];
+const COLUMNS = ["uav", "state", "flight", "battery", "alt", "heading", "task", "epoch", "control"];
+const COMMANDS = { hold: "H", return: "R", land: "L", resume: "\u25b6" }; // label: see the header
 
 let rows;
 
@@ -13,13 +17,31 @@ export function initFleet(table) {
     const tr = el("tr", { "data-uav": id });
     const cells = {};
     for (const name of COLUMNS) cells[name] = el("td", { class: `c-${name}` }, tr);
+    for (const [command, label] of Object.entries(COMMANDS)) {
+      const attrs = { type: "button", "data-command": command, title: command, text: label };
+      el("button", attrs, cells.control);
+    }
     return { node: tr, cells };
   });
   body.addEventListener("click", (event) => {
+    const button = event.target.closest("button[data-command]");
     const tr = event.target.closest("tr[data-uav]");
-    if (tr) select(tr.dataset.uav);
+    if (button && tr) command(`v1/uavs/${encodeURIComponent(tr.dataset.uav)}/control`, button);
+    else if (tr) select(tr.dataset.uav);
   });
+  const all = document.getElementById("hold-all");
+  if (all) all.addEventListener("click", () => command("v1/fleet/control", all, "hold"));
   onRender("fleet", render);
+}
+
+async function command(path, button, name = button.dataset.command) {
+  const said = document.getElementById("control-result");
+  try {
+    setFleet(await api("POST", path, { command: name }));
+    if (said) text(said, `${name}: sent`);
+  } catch (exc) {
+    if (said) text(said, `${name} refused: ${exc.code}: ${exc.message}`);
+  }
 }
 
 function render(s) {
@@ -32,7 +54,7 @@ function render(s) {
     const task = currentTask(id);
     const plan = s.plans.get(id);
     text(c.uav, id);
-    text(c.state, uav.state);
+    text(c.state, uav.silent_s ? `${uav.state} (silent ${Math.round(uav.silent_s)} s)` : uav.state);
     row.node.dataset.state = uav.state;
     text(c.flight, t ? `${t.flight_state}${t.mode ? ` ${t.mode}` : ""}` : "-");
     text(c.battery, t ? pct(t.battery_fraction) : "-");
@@ -42,6 +64,10 @@ function render(s) {
     const progress = uav.status && uav.status.task_id ? ` ${pct(uav.status.progress)}` : "";
     text(c.task, task ? `${task.task_id}${progress}` : "-");
     text(c.epoch, plan ? plan.epoch : uav.status ? uav.status.epoch : "-");
+    for (const button of c.control.querySelectorAll("button")) {
+      attr(button, "aria-pressed", String(button.dataset.command === uav.control));
+    }
+    row.node.dataset.control = uav.control || "";
     toggle(row.node, "selected", s.selected === id);
   }
   rows.prune(new Set(ids));

@@ -1,0 +1,39 @@
+"""List replies that always fit on the bus: cut into pages of at most
+``PAGE_BYTES`` encoded (and at most the caller's ``limit`` items), each
+ending with the cursor to continue after (the last item's id)."""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Sequence
+from typing import TypeVar
+
+import msgspec
+
+from proto.errors import RequestError
+
+T = TypeVar("T")
+
+PAGE_BYTES = 512 * 1024
+"""Encoded bytes of the items of one page: half the bus's message limit."""
+
+
+def page(
+    items: Sequence[T], key: Callable[[T], str], cursor: str | None, limit: int | None
+) -> tuple[list[T], str | None]:
+    """The items after ``cursor`` that fit one page, and the cursor of the
+    next page (None when this one is the last)."""
+    start = 0
+    if cursor is not None:
+        ids = [key(item) for item in items]
+        if cursor not in ids:
+            raise RequestError(f"unknown cursor {cursor!r}", code="invalid_request", field="cursor")
+        start = ids.index(cursor) + 1
+    out: list[T] = []
+    size = 0
+    for item in items[start:]:
+        n = len(msgspec.msgpack.encode(item))
+        if out and (size + n > PAGE_BYTES or (limit is not None and len(out) >= limit)):
+            return out, key(out[-1])
+        out.append(item)
+        size += n
+    return out, None
