@@ -71,7 +71,12 @@ def test_a_monitor_longer_than_one_battery_is_handed_over_and_recorded_as_flown(
     assert record["state"] == "completed", record
     covered, gap = truth.coverage(W2, 4.0, SAFETY.monitor_height_m, 1)
     assert covered >= 0.97 * duration, (covered, gap)
-    assert abs(record["monitored_s"] - covered) <= 0.02 * duration, (record, covered)
+    # what was recorded was flown, and what was flown for the action (the
+    # ring may stay held a little past its end) was recorded
+    assert abs(record["monitored_s"] - min(covered, duration)) <= 0.02 * duration, (
+        record,
+        covered,
+    )
     assert gap <= 5.0, f"{gap:.1f} s without a UAV watching W2"
     assert len(truth.watchers(W2, 4.0, SAFETY.monitor_height_m)) >= 2
     handovers = [e for e in truth.events() if e.kind == EventKind.HANDOVER]
@@ -276,10 +281,13 @@ def test_an_operator_holds_a_watching_uav_sends_it_home_and_gives_it_back(truth)
     assert {u["uav_id"]: u["control"] for u in fleet}[held] == "hold"
     since = truth.samples[-1].sim_s
     [relief] = truth.until("another UAV watches W2", lambda: on_station() - {held}, 90)
+    arrived = truth.samples[-1].sim_s
+    truth.until("it holds there 10 s", lambda: truth.samples[-1].sim_s > arrived + 10, 30)
     there = _xyz(_at(truth.samples[-1], held))
     later = [s for s in truth.samples if s.sim_s > since + 3]
     assert all(math.dist(_xyz(_at(s, held)), there) < 1.0 for s in later), "the held UAV moved"
-    assert math.dist(there, _xyz(_at(truth.samples[-1], relief))) > 3.0
+    holding = [s for s in truth.samples if s.sim_s > arrived + 5]
+    assert min(math.dist(there, _xyz(_at(s, relief))) for s in holding) > 3.0
     truth.gateway.call("POST", f"/v1/uavs/{held}/control", json={"command": "return"})
     home = PAPER.site.station(next(u.home_station for u in PAPER.fleet.uavs if u.id == held))
     spots = [_xyz(p) for p in spot_positions(home, PAPER.fleet)]
