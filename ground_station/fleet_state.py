@@ -22,20 +22,22 @@ AIRBORNE = frozenset({FlightState.FLYING, FlightState.TAKING_OFF, FlightState.LA
 
 def uavs_now(
     scenario: Scenario,
+    docks: Docks,
     monitor: FleetMonitor,
     plans: dict[str, Plan],
     in_force: set[str],
     controlled: frozenset[str] = frozenset(),
 ) -> list[UavNow]:
     """Every UAV of the fleet as of its latest telemetry (at home, full, if
-    none); one under an operator's command (``controlled``) takes no work."""
+    none; docked on a spot: at its station); one under an operator's command
+    (``controlled``) takes no work."""
     site, fleet = scenario.site, scenario.fleet
     uavs = []
     for spec in fleet.uavs:
         telemetry = monitor.telemetry(spec.id)
         home = site.station(spec.home_station)
         capacity = fleet.type_of(spec.id).battery_wh
-        docked = station_under(scenario, telemetry)
+        docked = docks.under(telemetry)
         where = telemetry.position if telemetry else home.position
         uavs.append(
             UavNow(
@@ -69,7 +71,7 @@ def running_action(monitor: FleetMonitor, plan: Plan | None, in_force: set[str])
 
 
 def drop_done_home(
-    scenario: Scenario, monitor: FleetMonitor, uav_id: str, tasks: list[Task]
+    docks: Docks, monitor: FleetMonitor, uav_id: str, tasks: list[Task]
 ) -> list[Task]:
     """A plan that only sends a UAV to the pad it already sits on asks
     nothing: it is empty (else the agent would "complete" it at once, over
@@ -77,18 +79,24 @@ def drop_done_home(
     telemetry = monitor.telemetry(uav_id)
     if len(tasks) != 1 or not isinstance(tasks[0], GoHomeTask) or telemetry is None:
         return tasks
-    station = station_under(scenario, telemetry)
+    station = docks.under(telemetry)
     return [] if station is not None and station.id == tasks[0].station_id else tasks
 
 
-def station_under(scenario: Scenario, telemetry: Telemetry | None) -> ChargingStation | None:
-    """The station a landed UAV sits on a spot of, if any: the planner,
-    whose stations are points, sees it at the station's position."""
-    if telemetry is None or telemetry.flight_state != FlightState.LANDED:
-        return None
-    p = telemetry.position
-    for station in scenario.site.stations:
-        for spot in spot_positions(station, scenario.fleet):
-            if math.hypot(p.x_m - spot.x_m, p.y_m - spot.y_m) <= ON_PAD_M:
+class Docks:
+    """Where UAVs sit at the stations (every station's spots, found once):
+    a landed UAV on a spot is at that station, for a planner whose stations
+    are points."""
+
+    def __init__(self, scenario: Scenario) -> None:
+        self._spots = [(s, spot_positions(s, scenario.fleet)) for s in scenario.site.stations]
+
+    def under(self, telemetry: Telemetry | None) -> ChargingStation | None:
+        """The station a landed UAV sits on a spot of, if any."""
+        if telemetry is None or telemetry.flight_state != FlightState.LANDED:
+            return None
+        p = telemetry.position
+        for station, spots in self._spots:
+            if any(math.hypot(p.x_m - q.x_m, p.y_m - q.y_m) <= ON_PAD_M for q in spots):
                 return station
-    return None
+        return None

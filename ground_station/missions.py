@@ -171,19 +171,16 @@ class MissionManager:
                 f"no UAV {request.uav_id!r} in the fleet", code="not_found", field="uav_id"
             )
         targets = [request.uav_id] if request.uav_id else [u.id for u in self.scenario.fleet.uavs]
-        now = self.clock()
+        control, now = self.replanner.control, self.clock()
         for uav_id in targets:
-            if request.command is not Command.RESUME and uav_id not in self._controlled():
+            if request.command is not Command.RESUME and uav_id not in control.controlled:
                 self._void_segments(uav_id)  # a held UAV keeps its slot: others get another
-            self.replanner.control.order(uav_id, request.command, now)
+            control.order(uav_id, request.command, now)
             self.replanner.resend(uav_id)
             self.events.emit(
                 EventKind.UAV_CONTROL, uav_id=uav_id, detail=f"operator: {request.command}"
             )
         self.request_replan(f"operator: {request.command} {request.uav_id or 'all'}", stale=True)
-
-    def _controlled(self) -> frozenset[str]:
-        return self.replanner.control.controlled
 
     def plan_quality(self) -> dict[str, float | None]:
         """The live plan's objective (seconds: weight-averaged completion +

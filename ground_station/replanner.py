@@ -17,7 +17,7 @@ import msgspec
 from ground_station import planner as pl
 from ground_station.event_log import EventLog
 from ground_station.fleet_monitor import FleetMonitor
-from ground_station.fleet_state import AIRBORNE, drop_done_home, uavs_now
+from ground_station.fleet_state import AIRBORNE, Docks, drop_done_home, uavs_now
 from ground_station.lifecycle import ActionEvent
 from ground_station.live_plan import (
     LivePlan,
@@ -69,6 +69,7 @@ class Replanner:
     ) -> None:
         self.scenario = scenario
         self.control = OperatorControl(scenario)  # UAVs an operator took out of the plan
+        self.docks = Docks(scenario)
         self.store = store
         self.monitor = monitor
         self.events = events
@@ -148,7 +149,12 @@ class Replanner:
             now_s=now_s,
             reason=reason,
             uavs=uavs_now(
-                self.scenario, self.monitor, self.plans, in_force, self.control.controlled
+                self.scenario,
+                self.docks,
+                self.monitor,
+                self.plans,
+                in_force,
+                self.control.controlled,
             ),
             starts=monitor_starts(self.plans.values()),
             version=self.version,
@@ -204,7 +210,7 @@ class Replanner:
         result, elapsed = computed.result, computed.elapsed_s
         ordered = {u: order.tasks for u, order in self.control.orders.items()}
         new_tasks = {
-            uav: drop_done_home(self.scenario, self.monitor, uav, tasks)
+            uav: drop_done_home(self.docks, self.monitor, uav, tasks)
             for uav, tasks in {**computed.tasks, **ordered}.items()
         }
         fleet = self.scenario.fleet

@@ -26,7 +26,7 @@ from ground_station.replanner import Replanner
 from ground_station.store import Store
 from linecrew.bus import Bus
 from linecrew.process import Shutdown
-from proto.errors import InvalidKey, RequestError
+from proto.errors import RequestError
 from proto.keys import KeySpace, Role, UavTopic
 from proto.rpc import REQUEST_OPS, GetMetrics, GetPlans, MetricsReply, PlansReply, Reply, Request
 from proto.scenario import Scenario
@@ -126,11 +126,7 @@ class GroundStation:
         """Whether a sample about ``uav_id`` came on that UAV's own key (under
         the secured profile, only its certificate may publish there); one
         that did not is dropped and counted."""
-        try:
-            parsed = self.keys.parse(key)
-        except InvalidKey:
-            parsed = None
-        if parsed is not None and parsed.kind == "uav" and parsed.ident == uav_id:
+        if self.keys.owns(key, "uav", uav_id):
             return self.monitor.known(uav_id)
         self.identity_mismatches += 1
         log.warning("dropped a sample about %s that came on %s", uav_id, key)

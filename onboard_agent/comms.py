@@ -61,7 +61,7 @@ class Comms:
     async def _spots(self) -> None:
         async with self.bus.subscribe_async(self.keys.all_station_spots(), StationSpots) as sub:
             async for key, feed in sub:
-                if self.keys.parse(key).ident == feed.station_id:  # trusted as far as its key
+                if self.keys.owns(key, "station", feed.station_id):
                     self.agent.ctx.spots.update(feed, self.agent.ctx.clock())
 
     async def _ground_stations(self) -> None:

@@ -134,6 +134,16 @@ class KeySpace:
         """Simulator control topic (e.g. ``fault``)."""
         return f"{self.prefix}/sim/{check_id(topic, 'sim topic')}"
 
+    def owns(self, key: str, kind: str, ident: str) -> bool:
+        """Whether ``key`` is a key of ``kind`` ``ident`` (``uav/uav-1/...``,
+        ``station/C1/...``): a sample is trusted only as far as the key it
+        came on. A key outside the key space belongs to nobody."""
+        try:
+            parsed = self.parse(key)
+        except InvalidKey:
+            return False
+        return parsed.kind == kind and parsed.ident == ident
+
     def parse(self, key: str) -> ParsedKey:
         """Split a concrete key of this site; raise :class:`InvalidKey` otherwise."""
         parts = str(key).split("/")

@@ -18,7 +18,6 @@ import time
 from collections.abc import Iterable
 
 from linecrew.bus import Bus
-from proto.errors import InvalidKey
 from proto.keys import KeySpace, UavTopic
 from proto.spots import SpotClaim, StationSpots
 from sim_fleet.physics import horizontal_distance
@@ -121,11 +120,7 @@ class SpotService:
 
     def on_claim(self, key: str, claim: SpotClaim) -> None:
         """A claim, trusted only on the key of the UAV it names; answered at once."""
-        try:
-            parsed = self.keys.parse(key)
-        except InvalidKey:
-            parsed = None
-        if parsed is None or parsed.kind != "uav" or parsed.ident != claim.uav_id:
+        if not self.keys.owns(key, "uav", claim.uav_id):
             log.warning("dropped a spot claim for %s that came on %s", claim.uav_id, key)
             return
         self.control.observe(self.world.vehicles.values(), self.world.time_s)

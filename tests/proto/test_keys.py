@@ -70,3 +70,13 @@ def test_ids_that_break_the_key_space_are_rejected(bad):
 def test_foreign_or_wildcard_keys_do_not_parse(key):
     with pytest.raises(InvalidKey):
         KeySpace().parse(key)
+
+
+def test_a_key_is_owned_only_by_the_kind_and_id_it_names():
+    keys = KeySpace("s1")
+    assert keys.owns(keys.telemetry("uav-1"), "uav", "uav-1")
+    assert not keys.owns(keys.telemetry("uav-2"), "uav", "uav-1")
+    assert keys.owns(keys.station_spots("C1"), "station", "C1")
+    assert not keys.owns(keys.station_spots("C1"), "uav", "C1")
+    assert not keys.owns("linecrew/s1/uav/*/telemetry", "uav", "*")  # a wildcard: nobody's
+    assert not keys.owns("elsewhere/uav-1", "uav", "uav-1")
