@@ -221,7 +221,6 @@ class GroundStation:
         for name, key in quality.items():
             if plan_quality[key] is not None:
                 values[name] = float(plan_quality[key])
-        for record in self.store.actions():
-            key = f"actions_{record.state}"
-            values[key] = values.get(key, 0) + 1
+        for state, count in self.store.action_counts().items():
+            values[f"actions_{state}"] = count
         return values

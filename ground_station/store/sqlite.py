@@ -171,6 +171,11 @@ class Store:
             )
             return self.counter(name)
 
+    def action_counts(self) -> dict[str, int]:
+        """How many actions are in each state (without decoding them)."""
+        rows = self._conn.execute("SELECT state, COUNT(*) FROM actions GROUP BY state")
+        return dict(rows.fetchall())
+
     def counter(self, name: str) -> int:
         """A named counter's value (0 if never incremented)."""
         row = self._conn.execute("SELECT value FROM counters WHERE name = ?", (name,)).fetchone()

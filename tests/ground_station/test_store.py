@@ -63,6 +63,9 @@ def test_actions_and_transitions_survive_reopening(path):
     ]
     assert store.actions([ActionState.PLANNED]) == [planned]
     assert store.actions([ActionState.COMPLETED]) == []
+    store.insert_action(record("a2"), 3.0)
+    store.insert_action(record("a3"), 3.0)
+    assert store.action_counts() == {"planned": 1, "accepted": 2}
 
 
 def test_request_ids_are_unique(path):
