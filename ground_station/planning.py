@@ -86,6 +86,7 @@ def build_problem(
         now_s=0.0,
         reserve_fraction=min(1.0, fleet.reserve_fraction + PLANNING_MARGIN),
         min_altitude_m=safety.ground_z_m + safety.min_altitude_m,
+        separation_m=safety.separation_m,
         stations=tuple(
             pl.Station(
                 id=s.id,

@@ -37,6 +37,7 @@ class AgentConfig:
     follow_threshold_m: float = 0.5  # re-target the slot when it moved more than this
     route_margin_m: float = 1.0  # a route passes people by their clearance plus this
     handover_hold_m: float = 3.0  # a relief holds this much farther out until its window begins
+    wait_aside_m: float = 3.0  # an airborne wait after monitoring hovers this far along the ring
     goto_resend_s: float = 1.0  # repeat a position target this often (no ACK exists)
     task_attempts: int = 3  # a task whose subtree failed this often is reported failed
     arm_attempts: int = 6  # arm / mode / takeoff refusals retried (with backoff) before failing

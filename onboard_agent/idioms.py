@@ -20,7 +20,7 @@ from onboard_agent.behaviours.gripper import PickTool, ReleaseTool
 from onboard_agent.behaviours.has_tool import HasTool
 from onboard_agent.behaviours.inspect import Inspect
 from onboard_agent.behaviours.is_idle import IsIdle
-from onboard_agent.behaviours.is_near import IsNear
+from onboard_agent.behaviours.is_near import IsNear, NoPlace
 from onboard_agent.behaviours.land import Land
 from onboard_agent.behaviours.mission_over import MissionOver
 from onboard_agent.behaviours.monitor import Monitor
@@ -110,8 +110,12 @@ def recharge_task(ctx: Context) -> Behaviour:
 
 
 def wait(ctx: Context) -> Behaviour:
-    """Wait: hold until the task's time (for synchronised monitoring)."""
-    return _subtree(Sequence("Wait Task", False, [WaitUntil(ctx)]), "WaitTask")
+    """Wait: hold until the task's time (for synchronised monitoring); on the
+    pad if landed; aside of the slot just left if it follows monitoring."""
+    aside = Selector(
+        "Aside", False, [NoPlace(targets.WAIT_ASIDE, ctx), go_near(targets.WAIT_ASIDE, ctx)]
+    )
+    return _subtree(Sequence("Wait Task", False, [aside, WaitUntil(ctx)]), "WaitTask")
 
 
 def go_home(ctx: Context) -> Behaviour:

@@ -47,6 +47,7 @@ class Mission:
         self._failures: dict[str, int] = {}
         self._tools: dict[str, str] = {}  # the tool a pick grabbed / a drop released, per task
         self._started: set[str] = set()
+        self.left_slot: MonitorTask | None = None  # the last task ended, if monitoring
 
     # -- plans --------------------------------------------------------------------
 
@@ -168,6 +169,7 @@ class Mission:
     def _pop(self, task: Task) -> None:
         if self.tasks and self.tasks[0].task_id == task.task_id:
             self.tasks.popleft()
+            self.left_slot = task if isinstance(task, MonitorTask) else None
 
     def _report(
         self,

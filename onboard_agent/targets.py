@@ -14,7 +14,15 @@ from collections.abc import Callable
 from onboard_agent.context import Context
 from onboard_agent.surroundings import horizontal_distance
 from proto.geo import Point
-from proto.plan import DeliverTask, GoHomeTask, InspectTask, MonitorTask, PickTask, RechargeTask
+from proto.plan import (
+    DeliverTask,
+    GoHomeTask,
+    InspectTask,
+    MonitorTask,
+    PickTask,
+    RechargeTask,
+    WaitTask,
+)
 from proto.site import ChargingStation
 
 
@@ -62,6 +70,20 @@ def _safe(ctx: Context, point: Point) -> Point:
     return point if point.z_m >= floor else Point(x_m=point.x_m, y_m=point.y_m, z_m=floor)
 
 
+def _ring_point(
+    ctx: Context, task: MonitorTask, radius_m: float, aside_m: float = 0.0
+) -> Point | None:
+    """The point ``radius_m`` from the task's worker on its slot's bearing,
+    ``height_m`` above them, moved ``aside_m`` along the ring (counter-clockwise)."""
+    worker = ctx.surroundings.worker_position(task.worker_id)
+    if worker is None:
+        return None
+    angle = math.radians(task.bearing_deg) + 2 * math.pi * task.slot / task.slots
+    x = worker.x_m + radius_m * math.cos(angle) - aside_m * math.sin(angle)
+    y = worker.y_m + radius_m * math.sin(angle) + aside_m * math.cos(angle)
+    return _safe(ctx, Point(x_m=x, y_m=y, z_m=worker.z_m + task.height_m))
+
+
 def monitor_slot(ctx: Context) -> Point | None:
     """Slot ``slot`` of ``slots`` on a circle of ``standoff_m`` around the
     worker (counted from the bearing ``bearing_deg``), ``height_m`` above
@@ -72,18 +94,22 @@ def monitor_slot(ctx: Context) -> Point | None:
     task = ctx.mission.head
     if not isinstance(task, MonitorTask):
         return None
-    worker = ctx.surroundings.worker_position(task.worker_id)
-    if worker is None:
-        return None
-    angle = math.radians(task.bearing_deg) + 2 * math.pi * task.slot / task.slots
     early = task.end_s > 0 and ctx.wall() < task.end_s - task.duration_s
     radius = task.standoff_m + (ctx.config.handover_hold_m if early else 0.0)
-    slot = Point(
-        x_m=worker.x_m + radius * math.cos(angle),
-        y_m=worker.y_m + radius * math.sin(angle),
-        z_m=worker.z_m + task.height_m,
-    )
-    return _safe(ctx, slot)
+    return _ring_point(ctx, task, radius)
+
+
+def wait_aside(ctx: Context) -> Point | None:
+    """Where an airborne wait that follows a monitoring segment hovers:
+    ``wait_aside_m`` along the ring from the slot it left, clear of the
+    relief that takes the slot over (coming in along the bearing). None
+    for any other wait, on the ground, or once the wait is over."""
+    task, left = ctx.mission.head, ctx.mission.left_slot
+    if not isinstance(task, WaitTask) or left is None or ctx.vehicle.landed:
+        return None
+    if ctx.wall() >= task.until_s:
+        return None
+    return _ring_point(ctx, left, left.standoff_m, ctx.config.wait_aside_m)
 
 
 def drop_point(ctx: Context) -> Point | None:
@@ -176,6 +202,7 @@ def station_target(pick: Callable[[Context], ChargingStation | None]) -> Target:
 
 WAYPOINT = Target("WP", waypoint, lambda c: c.config.near_waypoint_m)
 HUMAN_SLOT = Target("Human Target", monitor_slot, lambda c: c.config.near_slot_m)
+WAIT_ASIDE = Target("Aside", wait_aside, lambda c: c.config.near_slot_m)
 HUMAN_DROP = Target("Human Target", drop_point, lambda c: c.config.near_human_m, settle=True)
 TOOL_STATION = Target("Station", pick_point, lambda c: c.config.near_tool_station_m, settle=True)
 TOOL_RETURN = Target("Station", return_point, lambda c: c.config.near_tool_station_m, settle=True)

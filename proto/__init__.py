@@ -82,6 +82,7 @@ from proto.sim import (
     SimFault,
     SimState,
     VehicleTruth,
+    WatchRecord,
 )
 from proto.site import (
     BatterySwap,
@@ -210,6 +211,7 @@ __all__ = [
     "Vector",
     "VehicleTruth",
     "WaitTask",
+    "WatchRecord",
     "Waypoint",
     "WaypointSpec",
     "Worker",

@@ -112,6 +112,15 @@ class SafetyViolation(Record, frozen=True, kw_only=True):
     detail: str = ""
 
 
+class WatchRecord(Record, frozen=True, kw_only=True):
+    """Seconds ``uav_id`` hovered above ``worker_id`` within the simulator's
+    watch radius (its truth for monitoring; generous: any such hover counts)."""
+
+    worker_id: Id
+    uav_id: Id
+    seconds: float
+
+
 class VehicleTruth(Record, frozen=True, kw_only=True):
     """A vehicle as the simulator knows it."""
 
@@ -125,10 +134,12 @@ class VehicleTruth(Record, frozen=True, kw_only=True):
 
 
 class SimState(Message, frozen=True, kw_only=True):
-    """The simulator's ground truth: time, vehicles, deliveries."""
+    """The simulator's ground truth: time, vehicles, deliveries, safety
+    violations and watched seconds."""
 
     sim_time_s: float
     speedup: float
     vehicles: list[VehicleTruth] = []
     deliveries: list[DeliveryRecord] = []
     violations: list[SafetyViolation] = []
+    watched: list[WatchRecord] = []

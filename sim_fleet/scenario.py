@@ -132,6 +132,7 @@ class InteractionRules:
     delivery_radius_m: float = 2.5  # horizontal, UAV to worker at release
     delivery_height_m: float = 3.5  # max |dz| UAV to worker at release
     hover_speed_mps: float = 0.5  # below this a flying UAV counts as hovering
+    watch_radius_m: float = 15.0  # horizontal, hovering UAV to the worker it watches
 
 
 @dataclass(frozen=True, kw_only=True)

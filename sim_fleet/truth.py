@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 from proto.geo import Point
-from proto.sim import DeliveryRecord, SafetyViolation, SimState, VehicleTruth
+from proto.sim import DeliveryRecord, SafetyViolation, SimState, VehicleTruth, WatchRecord
 from sim_fleet.scenario import Vec3
 from sim_fleet.world import World
 
@@ -13,7 +13,7 @@ def _point(p: Vec3) -> Point:
 
 
 def sim_state(world: World, speedup: float) -> SimState:
-    """Vehicles, deliveries and safety violations of ``world`` now."""
+    """Vehicles, deliveries, safety violations and watched seconds of ``world`` now."""
     vehicles = []
     for vehicle in world.vehicles.values():
         docked = world.station_status(vehicle.id)
@@ -50,4 +50,8 @@ def sim_state(world: World, speedup: float) -> SimState:
         vehicles=vehicles,
         deliveries=deliveries,
         violations=violations,
+        watched=[
+            WatchRecord(worker_id=w, uav_id=u, seconds=s)
+            for (w, u), s in sorted(world.watch.seconds.items())
+        ],
     )

@@ -6,7 +6,8 @@ so the trajectory is the same whatever the speed-up or the caller's tick.
 Nothing here reads a clock or sleeps; the runner (``fleet``) or a test decides
 how much time passes. Fault operations are plain methods on the
 world and its vehicles so the later Zenoh fault service only has to call them.
-``deliveries``, ``drops`` and ``violations`` are the ground truth of outcomes.
+``deliveries``, ``drops``, ``violations`` and ``watch`` are the ground truth
+of outcomes.
 """
 
 from __future__ import annotations
@@ -23,6 +24,7 @@ from sim_fleet.scenario import Scenario, Vec3
 from sim_fleet.stations import ChargingStation
 from sim_fleet.tools import Delivery, Drop, ToolStation, station_in_reach, worker_in_reach
 from sim_fleet.vehicle import AutopilotParams, Vehicle
+from sim_fleet.watch import WatchLog
 
 log = logging.getLogger(__name__)
 
@@ -60,6 +62,7 @@ class World:
         self.drops: list[Drop] = []
         spots = (p for s in scenario.stations for p in s.spot_points)
         self.safety = SafetyMonitor(scenario.safety, spots, self.rules.dock_radius_m)
+        self.watch = WatchLog(self.rules)
 
     @property
     def violations(self) -> list[Violation]:
@@ -86,6 +89,7 @@ class World:
                 if v.state is not before:
                     self.safety.transition(v, before, self.time_s)
             self.safety.check(self.vehicles.values(), self.workers, self.time_s)
+            self.watch.step(self.vehicles.values(), self.workers, h)
             self._recharge(h)
 
     def _recharge(self, dt_s: float) -> None:

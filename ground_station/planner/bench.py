@@ -26,8 +26,8 @@ from typing import Any
 import msgspec
 
 from ground_station.planner.api import plan, score
-from ground_station.planner.generator import generate
-from ground_station.planner.model import DeliverAction, Problem
+from ground_station.planner.generator import generate, ring_bearing
+from ground_station.planner.model import DeliverAction, MonitorAction, Problem
 from ground_station.planner.replan import (
     ActionAdded,
     ActionCancelled,
@@ -91,6 +91,8 @@ def _next_event(s: Session, rng: random.Random, pool: list, n: int) -> Event | N
         a = pool[n % len(pool)]
         if isinstance(a, DeliverAction) and a.tool_station not in tool_stations(problem):
             a = msgspec.structs.replace(a, tool_station=problem.tool_stations[0].id)
+        if isinstance(a, MonitorAction):
+            a = msgspec.structs.replace(a, bearing_deg=ring_bearing(problem.actions, a.worker_m))
         return ActionAdded(action=msgspec.structs.replace(a, id=f"ev{n}"))
     if kind == "cancel":
         return ActionCancelled(action_id=rng.choice(problem.actions).id)

@@ -10,6 +10,7 @@ from __future__ import annotations
 from math import dist
 from operator import add
 
+from ground_station.planner.holds import HoldPoints
 from ground_station.planner.model import Problem, Station, Uav, UavType, Vec3
 
 EPS_S = 1e-6
@@ -61,14 +62,28 @@ def energy_after_recharge(
 
 
 class Site:
-    """Charging stations with memoised distance and nearest-station lookups."""
+    """Charging stations with memoised distance and nearest-station lookups,
+    and the index of each hold point's one-at-a-time reservation timeline in
+    the shared :class:`~ground_station.planner.pads.Pads` (after the
+    stations')."""
 
-    __slots__ = ("_cand", "_dists", "_near", "by_id", "charging", "positions", "swap_s", "wh_s")
+    __slots__ = (
+        "_cand",
+        "_dists",
+        "_near",
+        "by_id",
+        "charging",
+        "points",
+        "positions",
+        "swap_s",
+        "wh_s",
+    )
 
     def __init__(self, problem: Problem) -> None:
         self.by_id = {s.id: s for s in problem.stations}
         self.charging = [s for s in problem.stations if s.pads > 0]
         self.positions = [s.position_m for s in self.charging]
+        self.points = HoldPoints(problem, first=len(self.charging))
         self._near: dict[Vec3, tuple[float, int]] = {}
         self._dists: dict[Vec3, list[float]] = {}
         self._cand: dict[tuple[Vec3, Vec3], tuple[list[int], list[int], float]] = {}

@@ -10,7 +10,9 @@ Same arguments, same problem.
 
 from __future__ import annotations
 
+import itertools
 import random
+from collections.abc import Iterable
 from math import sin
 
 from ground_station.planner.model import (
@@ -23,6 +25,7 @@ from ground_station.planner.model import (
     ToolStation,
     Uav,
     UavType,
+    Vec3,
     Waypoint,
 )
 
@@ -53,6 +56,20 @@ TYPES = (
         hover_power_w=210.0,
     ),
 )
+
+
+RING_TURN_DEG = 37.0
+
+
+def ring_bearing(actions: Iterable[Action], worker_m: Vec3) -> float:
+    """A bearing for one more monitoring of the worker at ``worker_m``: the
+    first multiple of ``RING_TURN_DEG`` none of its monitors in ``actions``
+    uses, so that their slots never coincide (the ground station spreads
+    them alike)."""
+    taken = {
+        a.bearing_deg for a in actions if isinstance(a, MonitorAction) and a.worker_m == worker_m
+    }
+    return next(RING_TURN_DEG * i for i in itertools.count() if RING_TURN_DEG * i not in taken)
 
 
 def generate(n_uavs: int, n_actions: int, seed: int = 0) -> Problem:
@@ -129,6 +146,7 @@ def generate(n_uavs: int, n_actions: int, seed: int = 0) -> Problem:
             tx, ty, tz = towers[centre]
             actions.append(
                 MonitorAction(
+                    bearing_deg=ring_bearing(actions, (tx, ty, tz - 5.0)),
                     id=f"A{i:03d}",
                     weight=weight,
                     release_s=release,

@@ -182,3 +182,7 @@ class Problem(msgspec.Struct, frozen=True, kw_only=True):
     min_altitude_m: float = 0.0
     """Lowest z of any service position (waypoint, slot, pick, drop); the
     validator reports a step below it as ``too_low``."""
+    separation_m: float = 1.0
+    """No two UAVs hover closer than this at once (metres, 3-D): points
+    nearer each other are held one UAV at a time; the validator reports
+    ``separation``."""

@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 from bisect import bisect_left, insort
-from operator import itemgetter
 
 from ground_station.planner.energy import EPS_S
 
@@ -11,30 +10,42 @@ Ignore = tuple[str, float] | None
 """(uav_id, from_s): that UAV's reservations starting at or after from_s are
 ignored (they are being re-planned)."""
 
-_owner = itemgetter(2)
+
+_NONE: list[tuple[float, float, str]] = []
 
 
 class Pads:
-    """Reservations ``(start_s, end_s, uav_id)`` per charging-station index,
-    sorted by start."""
+    """Reservations ``(start_s, end_s, uav_id)`` per resource index (a
+    charging station's pads (``capacity``), or after them a hold point,
+    taken one UAV at a time), sorted by start. Sparse: only resources ever
+    reserved hold a list, and each UAV's reservations are indexed by start
+    (``by_uav``), so that thousands of hold points cost nothing until used
+    and dropping a UAV's reservations costs what it drops."""
 
-    __slots__ = ("capacity", "longest", "slots")
+    __slots__ = ("by_uav", "capacity", "longest", "slots")
 
     def __init__(self, capacity: list[int]) -> None:
-        self.capacity = capacity
-        self.slots: list[list[tuple[float, float, str]]] = [[] for _ in capacity]
-        self.longest = [0.0] * len(capacity)  # no reservation was ever longer (s)
+        self.capacity = capacity  # per charging station; any later index has 1
+        self.slots: dict[int, list[tuple[float, float, str]]] = {}
+        self.longest: dict[int, float] = {}  # no reservation was ever longer (s)
+        self.by_uav: dict[str, list[tuple[float, float, int]]] = {}  # (start, end, si)
 
     def copy(self) -> Pads:
         other = Pads(self.capacity)
-        other.slots = [list(s) for s in self.slots]
-        other.longest = list(self.longest)
+        other.slots = dict(self.slots)  # the lists are never changed in place
+        other.longest = dict(self.longest)
+        other.by_uav = {u: list(r) for u, r in self.by_uav.items()}
         return other
 
+    def _cap(self, si: int) -> int:
+        return self.capacity[si] if si < len(self.capacity) else 1
+
     def _after(self, si: int, t: float) -> list[tuple[float, float, str]]:
-        """Station ``si``'s reservations less those that surely end before
+        """Resource ``si``'s reservations less those that surely end before
         ``t`` (they start too early to last until then)."""
-        slots = self.slots[si]
+        slots = self.slots.get(si, _NONE)
+        if not slots:
+            return slots
         i = bisect_left(slots, (t - self.longest[si] - 1.0,))
         return slots[i:] if i else slots
 
@@ -53,7 +64,7 @@ class Pads:
 
     def earliest(self, si: int, t_from: float, duration_s: float, ign: Ignore) -> float:
         """Earliest start >= ``t_from`` with a free pad for ``duration_s``."""
-        cap = self.capacity[si]
+        cap = self._cap(si)
         slots = self._after(si, t_from)
         if len(slots) < cap:
             return t_from
@@ -89,7 +100,7 @@ class Pads:
         d = min(full_s, t_max - t_from)
         if t_from > t_max + EPS_S or d < min_s - EPS_S or d <= EPS_S:
             return None  # later starts are shorter still
-        cap = self.capacity[si]
+        cap = self._cap(si)
         slots = self._after(si, t_from)
         if cap == 1:
             t = t_from
@@ -122,14 +133,22 @@ class Pads:
 
     def remove_uav(self, uav_id: str, from_s: float, until_s: float = float("inf")) -> None:
         """Drop ``uav_id``'s reservations starting in [from_s, until_s)."""
-        lo, hi = from_s - EPS_S, until_s - EPS_S
-        for i, lst in enumerate(self.slots):
-            if uav_id in map(_owner, lst):
-                self.slots[i] = [r for r in lst if not (r[2] == uav_id and lo <= r[0] < hi)]
+        mine = self.by_uav.get(uav_id)
+        if not mine:
+            return
+        i = bisect_left(mine, (from_s - EPS_S,))
+        j = bisect_left(mine, (until_s - EPS_S,))
+        for start, end, si in mine[i:j]:
+            gone = (start, end, uav_id)
+            self.slots[si] = [r for r in self.slots[si] if r != gone]
+        del mine[i:j]
 
     def add(self, si: int, start_s: float, end_s: float, uav_id: str) -> None:
-        insort(self.slots[si], (start_s, end_s, uav_id))
-        self.longest[si] = max(self.longest[si], end_s - start_s)
+        lst = list(self.slots.get(si, _NONE))  # a new list: copies share the old one
+        insort(lst, (start_s, end_s, uav_id))
+        self.slots[si] = lst
+        self.longest[si] = max(self.longest.get(si, 0.0), end_s - start_s)
+        insort(self.by_uav.setdefault(uav_id, []), (start_s, end_s, si))
 
 
 def _busy(slots: list[tuple[float, float, str]], t_from: float, ign: Ignore) -> list:

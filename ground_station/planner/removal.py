@@ -15,8 +15,9 @@ from collections.abc import Callable
 from math import dist
 
 from ground_station.planner.energy import EPS_S, EPS_WH, energy_after_recharge
+from ground_station.planner.model import Vec3
 from ground_station.planner.routes import Ctx
-from ground_station.planner.simulate import State, Task
+from ground_station.planner.simulate import HOLDS, State, Task
 
 
 def remove_in_place(ctx: Ctx, uid: str, pred: Callable[[Task], bool]) -> list[Task] | None:
@@ -69,6 +70,8 @@ def remove_in_place(ctx: Ctx, uid: str, pred: Callable[[Task], bool]) -> list[Ta
             if new_start > t + EPS_S:  # idle where we are until it is time to go
                 if not landed:
                     e -= k.hover_whps * (new_start - t)
+                    if not _hold(ctx, uid, pos, t, new_start, res):
+                        return None
                 steps.append(("wait", t, t, new_start, e, pos, None, None, None, None, 0.0))
             e -= d * k.wh_per_m
             if d > 0:
@@ -85,8 +88,13 @@ def remove_in_place(ctx: Ctx, uid: str, pred: Callable[[Task], bool]) -> list[Ta
                 landed = landed or p in stations
                 if not landed:
                     e -= k.hover_whps * (end - arrive)
+                    if not _hold(ctx, uid, p, arrive, end, res):
+                        return None
             else:
                 e -= k.hover_whps * (end - arrive)
+                point = ctx.site.points.get(p) if kind in HOLDS else None
+                if point is not None:
+                    res.append((point, arrive, end))
                 if kind == "pick":
                     tool = tl
                 elif kind == "deliver":
@@ -105,3 +113,15 @@ def remove_in_place(ctx: Ctx, uid: str, pred: Callable[[Task], bool]) -> list[Ta
     for si, s, e2 in res:
         ctx.pads.add(si, s, e2, uid)
     return removed
+
+
+def _hold(ctx: Ctx, uid: str, pos: Vec3, start: float, end: float, res: list) -> bool:
+    """Reserve an airborne wait at ``pos`` if that is a hold point; False if
+    another UAV holds it then."""
+    point = ctx.site.points.get(pos)
+    if point is None or end - start <= EPS_S:
+        return True
+    if ctx.pads.earliest(point, start, end - start, (uid, -1e18)) > start + EPS_S:
+        return False
+    res.append((point, start, end))
+    return True

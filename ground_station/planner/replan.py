@@ -161,6 +161,7 @@ class Session:
                     raise PlanningProblemError("$.event.action.id", f"duplicate id {a.id!r}")
                 self._set_problem(replace(self.problem, actions=(*self.problem.actions, a)))
                 check_problem(self.problem)
+                self.ctx.site.points.add_action(a)
                 self._place([a])
             case ActionChanged(action=a):
                 self._require_action(a.id)
@@ -168,6 +169,7 @@ class Session:
                 acts = tuple(a if x.id == a.id else x for x in self.problem.actions)
                 self._set_problem(replace(self.problem, actions=acts))
                 check_problem(self.problem)
+                self.ctx.site.points.add_action(a)
                 self._place([a])
             case ActionCancelled(action_id=aid):
                 self._require_action(aid)

@@ -24,6 +24,9 @@ __all__ = ["Fail", "Sim", "State", "Task", "advance", "home_steps", "monitor_rea
 MAX_HOPS = 12
 LONG_WAIT_S = 120.0
 """An airborne UAV facing a longer idle wait lands to recharge if it can."""
+HOLDS = frozenset({"inspect", "pick", "deliver"})
+"""Tasks that hold a point (``Site.points``) one UAV at a time: a second
+UAV waits until the first has left (an airborne wait there holds it too)."""
 
 
 def _service_end_e(k: Kin, e_at: float, service_s: float) -> float:
@@ -43,6 +46,7 @@ def advance(
     soft: float | None = None,
 ) -> State | str:
     """Schedule ``task`` after ``st``; returns the new state or a reason code."""
+    st0, n_steps, n_res = st, len(steps), len(res)
     t, pos, e, landed, tool = st
     if task.kind == "pick" and tool is not None:
         return "tool_busy"
@@ -102,7 +106,21 @@ def advance(
         t, pos = st.t, st.pos
     else:
         service = task.service_s
+    point = site.points.get(task.pos) if task.kind in HOLDS else None
+    if point is not None:
+        free = pads.earliest(point, arr, service, ign)
+        if free > arr + EPS_S:  # another UAV holds the point then: come later
+            if anchor is not None or depth >= MAX_HOPS:
+                return "point_busy"
+            del steps[n_steps:], res[n_res:]
+            later = task.released(free)
+            return advance(k, site, pads, st0, later, steps, res, ign, depth + 1, soft)
     if wait > EPS_S:
+        here = None if st.landed else site.points.get(pos)
+        if here is not None:  # hovering on at a hold point: it stays taken
+            if pads.earliest(here, t, wait, ign) > t + EPS_S:
+                return "point_busy"
+            res.append((here, t, t + wait))
         steps.append(("wait", t, t, t + wait, e_wait, pos, None, None, None, None, 0.0))
     end = arr + service
     steps.append(
@@ -120,6 +138,8 @@ def advance(
             d,
         )
     )
+    if point is not None:
+        res.append((point, arr, end))
     if task.kind == "pick":
         tool = task.tool
     elif task.kind == "deliver":

@@ -60,6 +60,12 @@ class Task:
         t.full_s = self.full_s
         return t
 
+    def released(self, release_s: float) -> Task:
+        """This task, not to be started before ``release_s``."""
+        t = self.copy_topup()
+        t.topup, t.release_s = self.topup, release_s
+        return t
+
     def resumed(self) -> Task:
         """This running task redone in full (after a recharge or interruption)."""
         if self.full_s is None:

@@ -10,7 +10,7 @@ each with a stable code; an empty list means the plan is valid.
 from __future__ import annotations
 
 from collections import defaultdict
-from math import cos, dist, pi, sin
+from math import cos, dist, pi, radians, sin
 
 from ground_station.planner.model import DeliverAction, InspectAction, MonitorAction, Problem
 from ground_station.planner.result import Plan, Violation
@@ -19,6 +19,9 @@ TOL_S = 1e-3
 TOL_WH = 1e-3
 TOL_M = 0.01
 STANDOFF_TOL_M = 0.5
+WAIT_ASIDE_M = 3.0
+"""The agents' rule: an airborne wait right after a monitoring segment
+hovers this far along the ring from the slot (``AgentConfig.wait_aside_m``)."""
 SERVICE_KIND = {"inspect": "inspect", "monitor": "monitor", "pick": "deliver", "deliver": "deliver"}
 KIND_OF = {InspectAction: "inspect", MonitorAction: "monitor", DeliverAction: "deliver"}
 
@@ -47,6 +50,7 @@ def validate(problem: Problem, plan: Plan) -> list[Violation]:
     monitor_iv: dict[str, list[tuple[int, float, float]]] = defaultdict(list)
     waypoints: dict[str, list[int]] = defaultdict(list)
     delivered: dict[str, int] = defaultdict(int)
+    holds: list[tuple[float, float, tuple[float, float, float], str]] = []
     for up in plan.uavs:
         uid = up.uav_id
         u = uavs.get(uid)
@@ -106,6 +110,9 @@ def validate(problem: Problem, plan: Plan) -> list[Violation]:
             act = actions.get(s.action_id) if s.action_id is not None else None
             if emergency and s.kind in SERVICE_KIND:
                 rep.add("below_reserve", f"{where}: works before recovering from low battery", uid)
+            hold = _hold_point(s, up.steps[n - 1] if n else None, actions, at_station, landed)
+            if hold is not None and serve > TOL_S:
+                holds.append((s.arrive_s, s.end_s, hold, uid))
             if s.kind in SERVICE_KIND:
                 drop_s = None  # a running delivery may finish with its remaining drop time
                 run = u.running
@@ -190,6 +197,7 @@ def validate(problem: Problem, plan: Plan) -> list[Violation]:
             if s.kind in ("recharge", "home") and emergency:
                 emergency, floor = False, normal_floor
     _check_pads(rep, stations, pad_use)
+    _check_separation(rep, problem.separation_m, holds)
     _check_actions(rep, problem, plan, monitor_iv, waypoints, delivered)
     return rep.items
 
@@ -227,12 +235,48 @@ def _check_action_step(rep, problem, uid, caps, s, act, where, drop_s=None) -> N
             rep.add("service_too_short", f"{where}: pick too short", uid, act.id)
 
 
-def _slot(act: MonitorAction, slot: int) -> tuple[float, float, float]:
-    """Where slot ``slot`` is, from the action's definition (not the planner's code)."""
+def _slot(act: MonitorAction, slot: int, aside_m: float = 0.0) -> tuple[float, float, float]:
+    """Where slot ``slot`` is, from the action's definition (not the
+    planner's code); ``aside_m`` along the ring (counter-clockwise)."""
     x, y, z = act.worker_m
-    bearing = 2 * pi * slot / act.k
+    bearing = radians(act.bearing_deg) + 2 * pi * slot / act.k
     r = act.standoff_m
-    return (x + r * cos(bearing), y + r * sin(bearing), z + act.height_m)
+    return (
+        x + r * cos(bearing) - aside_m * sin(bearing),
+        y + r * sin(bearing) + aside_m * cos(bearing),
+        z + act.height_m,
+    )
+
+
+def _hold_point(s, before, actions, at_station, landed):  # type: ignore[no-untyped-def]
+    """Where step ``s`` hovers (None if it does not): its position for work,
+    an airborne wait's too, or aside of the slot it follows (``WAIT_ASIDE_M``)."""
+    if s.kind in SERVICE_KIND:
+        return s.position_m
+    if s.kind != "wait" or at_station or landed:
+        return None
+    if before is not None and before.kind == "monitor" and before.index is not None:
+        act = actions.get(before.action_id)
+        if isinstance(act, MonitorAction):
+            return _slot(act, before.index, WAIT_ASIDE_M)
+    return s.position_m
+
+
+def _check_separation(rep: _Report, separation_m: float, holds) -> None:  # type: ignore[no-untyped-def]
+    """No two UAVs hover nearer than ``separation_m`` at once."""
+    active: list[tuple[float, float, tuple[float, float, float], str]] = []
+    for hold in sorted(holds):
+        start, end, where, uid = hold
+        active = [a for a in active if a[1] > start + TOL_S]
+        for _, other_end, there, other in active:
+            if other != uid and dist(where, there) < separation_m - TOL_M:
+                rep.add(
+                    "separation",
+                    f"{dist(where, there):.2f} m from {other} "
+                    f"{start:.1f}-{min(end, other_end):.1f} s",
+                    uid,
+                )
+        active.append(hold)
 
 
 def _check_pads(rep: _Report, stations, pad_use) -> None:  # type: ignore[no-untyped-def]

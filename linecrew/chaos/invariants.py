@@ -12,6 +12,10 @@
 - ``unsafe``: the simulator records no safety violation (two UAVs closer
   than the separation, a UAV near a person, a landing off every spot, a
   crash); a crash of a UAV a fault was injected on is reported as excused.
+- ``overcredited``: no worker's recorded monitoring (each monitor action's
+  ``monitored_s`` times its UAVs) exceeds the seconds the simulator saw
+  UAVs hover watching that worker, beyond ``CREDIT_TOLERANCE`` and
+  ``CREDIT_SLACK_S`` per UAV of each action (settling at the slot).
 - ``unfinished``: at the end every accepted action has completed or failed;
   ``failed_without_reason``: a failed action carries a reason.
 
@@ -32,6 +36,8 @@ TERMINAL = frozenset({"completed", "failed", "cancelled"})
 HANDOVER_S = 30.0  # mission seconds two monitoring segments of one slot may overlap
 # status task ids that name UAV-scoped work (never shared by construction)
 _OWN_TASKS = ("recharge", "wait", "home")
+CREDIT_TOLERANCE = 0.02  # recorded monitoring may exceed the watched seconds by this share
+CREDIT_SLACK_S = 5.0  # and by this many seconds per UAV of each monitor action
 
 
 @dataclasses.dataclass(frozen=True)
@@ -58,6 +64,7 @@ class Checker:
         self._executing_twice: set[str] = set()  # task ids seen doubled on the last sample
         self._seen: set[tuple[str, str]] = set()  # (invariant, detail) already reported
         self._unsafe_seen = 0  # the simulator's violations already judged
+        self._overcredited: set[str] = set()  # workers already reported
 
     # -- inputs ------------------------------------------------------------------
 
@@ -87,6 +94,8 @@ class Checker:
         if truth is not None:
             self._check_reserve(at_s, truth)
             self._check_safety(at_s, truth)
+            if actions is not None:  # the truth was read after the actions
+                self._check_credit(at_s, actions, truth)
 
     def finish(self, at_s: float, actions: list[dict[str, Any]] | None) -> None:
         """The end-of-run checks on the final action list."""
@@ -194,6 +203,31 @@ class Checker:
             else:
                 self._violate(at_s, "unsafe", where)
         self._unsafe_seen = max(self._unsafe_seen, len(truth.violations))
+
+    def _check_credit(self, at_s: float, actions: list[dict[str, Any]], truth: SimState) -> None:
+        self.checks["overcredited"] += 1
+        recorded: collections.Counter[str] = collections.Counter()
+        slack: collections.Counter[str] = collections.Counter()
+        for record in actions:
+            action = record.get("action") or {}
+            if action.get("type") != "monitor":
+                continue
+            uavs = action.get("uavs", 1)
+            recorded[action["worker_id"]] += record.get("monitored_s", 0.0) * uavs
+            slack[action["worker_id"]] += CREDIT_SLACK_S * uavs
+        watched: collections.Counter[str] = collections.Counter()
+        for w in truth.watched:
+            watched[w.worker_id] += w.seconds
+        for worker, seconds in sorted(recorded.items()):
+            allowed = watched[worker] * (1 + CREDIT_TOLERANCE) + slack[worker]
+            if seconds > allowed and worker not in self._overcredited:
+                self._overcredited.add(worker)
+                self._violate(
+                    at_s,
+                    "overcredited",
+                    f"{worker}: {seconds:.0f} UAV-s of monitoring recorded, "
+                    f"{watched[worker]:.0f} s watched",
+                )
 
     def _violate(self, at_s: float, invariant: str, detail: str) -> None:
         if (invariant, detail) in self._seen:

@@ -5,7 +5,15 @@ from __future__ import annotations
 
 from linecrew.chaos.runner import ChaosResult
 
-INVARIANTS = ("action_lost", "double_task", "below_reserve", "unfinished", "failed_without_reason")
+INVARIANTS = (
+    "action_lost",
+    "double_task",
+    "below_reserve",
+    "unsafe",
+    "overcredited",
+    "unfinished",
+    "failed_without_reason",
+)
 
 
 def render(result: ChaosResult) -> str:

@@ -10,7 +10,7 @@ import pytest
 from linecrew.chaos import Checker, main, make_schedule
 from linecrew.chaos.schedule import DISRUPTIONS
 from linecrew.scenarios import load
-from proto import Point, SafetyViolation, SimState
+from proto import Point, SafetyViolation, SimState, WatchRecord
 
 PAPER = load("paper")
 SEED = 7
@@ -92,3 +92,32 @@ def test_a_short_seeded_run_reports_zero_violations(tmp_path, capsys):
     assert "violations: 0" in report, report
     assert f"reproduce: linecrew chaos --seed {SEED}" in report
     assert code == 0, report
+
+
+def _monitor(worker: str, uavs: int, monitored_s: float) -> dict:
+    action = {"type": "monitor", "worker_id": worker, "uavs": uavs, "duration_s": 600.0}
+    return {
+        "action_id": f"m-{worker}",
+        "state": "in_progress",
+        "action": action,
+        "monitored_s": monitored_s,
+    }
+
+
+def test_the_checker_flags_monitoring_recorded_beyond_what_the_simulator_saw_watched():
+    checker = Checker(reserve_fraction=0.2)
+    watched = [
+        WatchRecord(worker_id="W1", uav_id="uav-1", seconds=100.0),
+        WatchRecord(worker_id="W1", uav_id="uav-2", seconds=98.0),
+        WatchRecord(worker_id="W2", uav_id="uav-3", seconds=50.0),
+    ]
+    truth = SimState(sim_time_s=200.0, speedup=1.0, watched=watched)
+    honest = [_monitor("W1", 2, 100.0), _monitor("W2", 1, 50.0)]
+    checker.sample(1.0, honest, None, None, truth)
+    assert checker.checks["overcredited"] == 1 and not checker.violations
+    inflated = [_monitor("W1", 2, 100.0), _monitor("W2", 1, 120.0)]  # 120 s recorded, 50 flown
+    checker.sample(2.0, inflated, None, None, truth)
+    checker.sample(3.0, inflated, None, None, truth)  # reported once
+    assert [(v.invariant, v.detail) for v in checker.violations] == [
+        ("overcredited", "W2: 120 UAV-s of monitoring recorded, 50 s watched")
+    ]

@@ -7,8 +7,9 @@ import math
 import msgspec
 import pytest
 
+from ground_station.planner.validate import WAIT_ASIDE_M
 from proto.geo import GeoPoint
-from proto.plan import MonitorTask
+from proto.plan import MonitorTask, WaitTask
 from proto.telemetry import HumanPose, OutcomeResult
 from tests.onboard_agent.helpers import SCENARIO, Rig, plan, point
 
@@ -95,3 +96,28 @@ def test_a_timed_segment_holds_clear_of_the_slot_until_its_window_then_leaves_at
     [outcome] = rig.outcomes()
     assert outcome.result is OutcomeResult.COMPLETED
     assert outcome.flown_s == pytest.approx(4.0 - 0.5, abs=1.0)  # only seconds in the window
+
+
+def test_a_wait_after_a_segment_hovers_aside_of_the_slot_clear_of_its_relief():
+    rig = Rig()
+    wait = WaitTask(task_id="w1", until_s=rig.wall() + 30.0)
+    rig.agent.offer_plan(plan(monitor(slot=0, slots=1, duration_s=2.0), wait))
+    rig.run_until(lambda: isinstance(rig.mission.head, WaitTask))
+    rig.run_until(lambda: rig.leaf() == "Wait")
+    aside = last_goto(rig)
+    config = rig.agent.ctx.config
+    # along the ring (counter-clockwise), at the slot's height
+    assert (aside.x_m, aside.y_m) == pytest.approx((W2.x_m + 4.0, W2.y_m + config.wait_aside_m))
+    # the relief comes in from handover_hold_m out on the bearing: its path stays clear
+    relief_path = [(W2.x_m + 4.0 + f * config.handover_hold_m, W2.y_m) for f in (0, 0.5, 1)]
+    assert min(math.dist((aside.x_m, aside.y_m), p) for p in relief_path) >= config.wait_aside_m
+    assert config.wait_aside_m == WAIT_ASIDE_M  # the rule the planner's validator checks plans by
+    rig.run_until(lambda: rig.mission.head is None)
+    assert [o.result for o in rig.outcomes()] == [OutcomeResult.COMPLETED] * 2
+
+
+def test_a_wait_that_follows_no_segment_holds_where_it_is():
+    rig = Rig()
+    rig.agent.offer_plan(plan(WaitTask(task_id="w1", until_s=rig.wall() + 3.0)))
+    rig.run_until(lambda: rig.mission.head is None)
+    assert not [name for name, _ in rig.autopilot.calls if name == "goto"]

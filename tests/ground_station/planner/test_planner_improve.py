@@ -91,7 +91,7 @@ def test_time_bounded_improvement_runs_independent_restarts() -> None:
 def test_objective_is_the_exported_score_home_legs_included() -> None:
     # Here UAVs recharge before flying home at the end; an objective without
     # the home legs was 400 s below the plan's score and misled the search.
-    problem = generate(5, 20, 0)
+    problem = generate(5, 20, 1)
     ctx = build(problem)
     improve(ctx, lambda: False, max_rounds=50)
     exported = export(ctx)

@@ -7,6 +7,7 @@ from itertools import pairwise
 import msgspec
 
 from ground_station.planner import (
+    DeliverAction,
     InspectAction,
     Problem,
     RunningTask,
@@ -109,3 +110,51 @@ def test_running_task_is_interrupted_only_when_j3_says_it_pays(fig6: Problem) ->
     assert validate(short_left, result) == []
     first = result.uavs[0].steps[0]
     assert (first.kind, first.action_id, first.index) == ("inspect", "a4-inspect", 0)
+
+
+def _holds_at(result, point, kind):
+    return sorted(
+        (s.arrive_s, s.end_s, u.uav_id)
+        for u in result.uavs
+        for s in u.steps
+        if s.kind == kind and s.position_m == point
+    )
+
+
+def test_two_inspections_of_one_point_take_turns(fig6: Problem) -> None:
+    point = (3.0, 12.0, 4.0)
+    both = tuple(
+        InspectAction(id=f"look-{n}", waypoints=(Waypoint(position_m=point, service_s=60.0),))
+        for n in (1, 2)
+    )
+    problem = replace(fig6, actions=both)
+    result = plan(problem, max_rounds=50)
+    assert validate(problem, result) == []
+    first, second = _holds_at(result, point, "inspect")
+    assert second[0] >= first[1] - 1e-6  # one after the other, never both at the point
+
+
+def test_picks_at_one_tool_station_take_turns(fig6: Problem) -> None:
+    physical = replace(fig6.uavs[0], id="uav3", position_m=(0.0, 20.0, 0.0), home_station="C2")
+    deliveries = tuple(
+        DeliverAction(id=f"bring-{n}", tool="wrench", tool_station="tools", worker_m=w, pick_s=60.0)
+        for n, w in ((1, (0.0, 10.0, 3.0)), (2, (8.0, 2.0, 3.0)))
+    )
+    problem = replace(fig6, uavs=(*fig6.uavs, physical), actions=deliveries)
+    result = plan(problem, max_rounds=50)
+    assert validate(problem, result) == []
+    station = fig6.tool_stations[0].position_m
+    first, second = _holds_at(result, station, "pick")
+    assert second[0] >= first[1] - 1e-6
+
+
+def test_the_validator_reports_two_uavs_hovering_at_one_point_at_once(fig6: Problem) -> None:
+    result = plan(fig6)
+    assert validate(fig6, result) == []
+    one, other = (next(s for s in u.steps if s.kind == "inspect") for u in result.uavs[:2])
+    # the second UAV's inspection moved onto the first's point and time
+    moved = replace(other, position_m=one.position_m, arrive_s=one.arrive_s, end_s=one.end_s)
+    steps = tuple(moved if s is other else s for s in result.uavs[1].steps)
+    uavs = (result.uavs[0], replace(result.uavs[1], steps=steps), *result.uavs[2:])
+    found = [v for v in validate(fig6, replace(result, uavs=uavs)) if v.code == "separation"]
+    assert found and found[0].uav_id in {result.uavs[0].uav_id, result.uavs[1].uav_id}
