@@ -352,13 +352,14 @@ class MissionManager:
 
     def retry_unplaced(self) -> None:
         """Replan every ``RETRY_UNPLACED_S`` mission seconds while an action
-        waits for a UAV: batteries filling on pads are no event, yet they
-        make the action placeable (a replan that places nothing changes nothing)."""
+        waits for a UAV (accepted, or in progress with a part the plan left
+        out): batteries filling on pads are no event, yet they make the work
+        placeable (a replan that places nothing changes nothing)."""
         now = self.clock()
         if now - self._retried_s < RETRY_UNPLACED_S:
             return
         self._retried_s = now
-        if self.store.actions([ActionState.ACCEPTED]):
+        if self.replanner.waiting or self.store.actions([ActionState.ACCEPTED]):
             self.request_replan("retry of actions waiting for a UAV")
 
     # -- planning --------------------------------------------------------------

@@ -80,6 +80,7 @@ class Replanner:
         self.plans: dict[str, Plan] = store.latest_plans()
         self.stats = ReplanStats()
         self.version = 0  # bumped by changes that make a replan in flight stale
+        self.waiting: set[str] = set()  # actions the adopted plan leaves (partly) unplaced
         self.objective: Objective | None = None  # of the live plan
         self.best_objective: Objective | None = None  # best seen for this state
         self.improved_s: float | None = None  # mission s of the last adopted improvement
@@ -270,6 +271,7 @@ class Replanner:
                 f"{elapsed * 1e3:.1f} ms ({how})",
             )
         action_events = _action_events(job.records, new_tasks, result)
+        self.waiting = {u.action_id for u in result.unplaced}
         return ReplanOutcome(epoch, changed, action_events, elapsed)
 
     # -- improvement ------------------------------------------------------------

@@ -12,7 +12,7 @@ import itertools
 import math
 from collections.abc import Callable
 
-from linecrew.client.gateway import Gateway
+from linecrew.client.gateway import Gateway, GatewayError
 from linecrew.launch.local_run import LocalRun
 from proto import GetHistory, GetSimState, GsEvent, HistoryReply, Point, SimState
 from tests.support.processes import wait_until
@@ -65,7 +65,14 @@ class TruthLog:
         return self.gateway.call("GET", f"/v1/actions/{action_id}")
 
     def finished(self, *action_ids: str) -> bool:
-        return all(self.action(a)["state"] in TERMINAL for a in action_ids)
+        """Whether the actions ended; not yet while the ground station is
+        busy catching up (a 503, as documented) after a fault."""
+        try:
+            return all(self.action(a)["state"] in TERMINAL for a in action_ids)
+        except GatewayError as exc:
+            if exc.status == 503:
+                return False
+            raise
 
     def events(self) -> list[GsEvent]:
         assert self.run.bus is not None

@@ -304,6 +304,23 @@ def test_an_action_no_uav_can_take_yet_is_retried_as_time_passes(gs):
     assert gs.replanner.stats.count == replans + 1
 
 
+def test_an_action_in_progress_whose_rest_no_uav_can_take_is_retried_too(gs):
+    submit(gs, MonitorAction(worker_id="W2", uavs=1, standoff_m=4, duration_s=600), "watch")
+    uav, segment = next(
+        (u, t) for u in ALL for t in gs.replanner.plans[u].tasks if isinstance(t, MonitorTask)
+    )
+    gs.now = segment.start_s + 20.0
+    outcome(gs, uav, segment, flown_s=20.0)  # cut short: the rest is still to fly
+    gs.advance(10)  # then nobody is heard: no UAV can take the rest
+    assert gs.store.action("watch").state == ActionState.IN_PROGRESS
+    assert gs.replanner.waiting == {"watch"}
+    replans = gs.replanner.stats.count
+    gs.now += 31
+    gs.manager.retry_unplaced()
+    gs.settle()
+    assert gs.replanner.stats.count == replans + 1
+
+
 def test_an_agent_idle_on_a_plan_that_still_has_work_gets_it_again(gs):
     submit(gs, DeliverAction(tool="wrench", tool_station_id="tp-wrench", worker_id="W1"), "d")
     plan = gs.replanner.plans["uav-1"]
