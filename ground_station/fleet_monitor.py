@@ -19,7 +19,14 @@ import dataclasses
 import enum
 
 from proto.rpc import UavOpState, UavState
-from proto.telemetry import AgentState, AgentStatus, FlightState, Telemetry
+from proto.telemetry import (
+    AgentState,
+    AgentStatus,
+    FlightState,
+    Telemetry,
+    Traffic,
+    TrafficEntry,
+)
 
 _FROM_AGENT = {
     AgentState.IDLE: UavOpState.IDLE,
@@ -31,6 +38,10 @@ _FROM_AGENT = {
 }
 
 
+TRAFFIC_MAX_AGE_S = 60.0
+"""UAVs last heard airborne longer ago than this are left out of the
+traffic (a hung UAV may hover on where it was for that long)."""
+AIRBORNE = frozenset({FlightState.TAKING_OFF, FlightState.FLYING, FlightState.LANDING})
 SILENT_AFTER_S = 1.0
 """Silence (s) after which a present UAV is shown as silent: several telemetry periods."""
 
@@ -49,7 +60,8 @@ class Change(enum.StrEnum):
 class _Uav:
     token: bool = False
     token_lost_s: float | None = None
-    heard_s: float | None = None  # last telemetry
+    heard_s: float | None = None  # last telemetry (or status)
+    telemetry_s: float | None = None  # when ``telemetry`` arrived
     lost: bool = True
     lost_s: float | None = None
     telemetry: Telemetry | None = None
@@ -93,7 +105,7 @@ class FleetMonitor:
         uav = self._uavs.get(telemetry.uav_id)
         if uav is not None:
             uav.telemetry = telemetry
-            uav.heard_s = now_s
+            uav.heard_s = uav.telemetry_s = now_s
 
     def on_status(self, status: AgentStatus, now_s: float | None = None) -> None:
         """An agent status arrived (at ``now_s`` of the receiver's clock: the
@@ -158,6 +170,22 @@ class FleetMonitor:
     def status(self, uav_id: str) -> AgentStatus | None:
         """The latest status of ``uav_id``."""
         return self._uavs[uav_id].status
+
+    def traffic(self, now_s: float) -> Traffic:
+        """Every UAV last heard airborne (within ``TRAFFIC_MAX_AGE_S``),
+        lost ones included: where they were is where they may still hover."""
+        entries = []
+        for uav_id, uav in self._uavs.items():
+            t, seen = uav.telemetry, uav.telemetry_s
+            if t is None or seen is None or now_s - seen > TRAFFIC_MAX_AGE_S:
+                continue
+            airborne = t.flight_state in AIRBORNE
+            entries.append(
+                TrafficEntry(
+                    uav_id=uav_id, position=t.position, airborne=airborne, age_s=now_s - seen
+                )
+            )
+        return Traffic(uavs=entries)
 
     def snapshot(self) -> list[UavState]:
         """Every UAV's state for a :class:`proto.rpc.FleetReply`."""

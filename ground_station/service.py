@@ -32,6 +32,8 @@ from proto.rpc import REQUEST_OPS, GetMetrics, GetPlans, MetricsReply, PlansRepl
 from proto.scenario import Scenario
 from proto.telemetry import AgentStatus, TaskOutcome, Telemetry
 
+TRAFFIC_PERIOD_S = 0.5
+
 log = logging.getLogger("linecrew.ground_station")
 
 
@@ -107,6 +109,7 @@ class GroundStation:
                     group.create_task(self._consume(outcomes, self._on_outcome)),
                     group.create_task(self._consume(tokens, self._on_token)),
                     group.create_task(self._watchdog()),
+                    group.create_task(self._traffic()),
                     group.create_task(self.manager.worker.run()),
                 ]
                 await shutdown.wait_async()
@@ -160,6 +163,15 @@ class GroundStation:
             except Exception:
                 log.exception("watchdog step failed")
             await asyncio.sleep(self.config.watchdog_period_s)
+
+    async def _traffic(self) -> None:
+        """Tell the agents where every UAV is, ``TRAFFIC_PERIOD_S`` apart."""
+        while True:
+            try:
+                self.bus.publish(self.keys.traffic(), self.monitor.traffic(time.monotonic()))
+            except Exception:
+                log.exception("traffic report not sent")
+            await asyncio.sleep(TRAFFIC_PERIOD_S)
 
     def _rpc_handler(self, op: str) -> Callable[[Request], Reply]:
         def handle(request: Request) -> Reply:

@@ -24,6 +24,7 @@ from onboard_agent.energy import EnergyModel
 from onboard_agent.mission import Mission, PlanVerdict
 from onboard_agent.spots import Spots
 from onboard_agent.surroundings import Surroundings
+from onboard_agent.traffic import Traffic
 from proto.errors import LinecrewError
 from proto.plan import Plan
 from proto.scenario import Scenario
@@ -64,6 +65,7 @@ class Agent:
             mission=Mission(uav_id, scenario.site, wall),
             surroundings=Surroundings(scenario.site),
             spots=Spots(uav_id, scenario),
+            traffic=Traffic(uav_id),
             energy=energy,
             clock=clock,
             wall=wall,

@@ -21,6 +21,7 @@ from proto.plan import Plan
 from proto.rpc import GetPlans, PlansReply
 from proto.spots import StationSpots
 from proto.telemetry import HumanPose
+from proto.telemetry import Traffic as TrafficReport
 
 log = logging.getLogger(__name__)
 
@@ -45,6 +46,7 @@ class Comms:
                 group.create_task(self._plans())
                 group.create_task(self._poses())
                 group.create_task(self._spots())
+                group.create_task(self._traffic())
                 group.create_task(self._ground_stations())
                 group.create_task(self._telemetry())
 
@@ -63,6 +65,11 @@ class Comms:
             async for key, feed in sub:
                 if self.keys.owns(key, "station", feed.station_id):
                     self.agent.ctx.spots.update(feed, self.agent.ctx.clock())
+
+    async def _traffic(self) -> None:
+        async with self.bus.subscribe_async(self.keys.traffic(), TrafficReport) as sub:
+            async for _key, report in sub:
+                self.agent.ctx.traffic.update(report, self.agent.ctx.link_clock())
 
     async def _ground_stations(self) -> None:
         key = self.keys.all_alive(Role.GROUND_STATION)

@@ -38,6 +38,9 @@ class AgentConfig:
     route_margin_m: float = 1.0  # a route passes people by their clearance plus this
     handover_hold_m: float = 3.0  # a relief holds this much farther out until its window begins
     wait_aside_m: float = 3.0  # an airborne wait after monitoring hovers this far along the ring
+    keep_clear_m: float = 2.0  # never fly to a point another airborne UAV is this near (traffic)
+    yield_max_s: float = 30.0  # hold off at most this long (mission s), then fly on
+    handover_grace_s: float = 10.0  # a relief closes in on its slot this long whoever is there
     goto_resend_s: float = 1.0  # repeat a position target this often (no ACK exists)
     task_attempts: int = 3  # a task whose subtree failed this often is reported failed
     arm_attempts: int = 6  # arm / mode / takeoff refusals retried (with backoff) before failing

@@ -17,6 +17,7 @@ from onboard_agent.energy import EnergyModel
 from onboard_agent.mission import Mission
 from onboard_agent.spots import Spots
 from onboard_agent.surroundings import Surroundings
+from onboard_agent.traffic import Traffic
 
 
 @dataclasses.dataclass(kw_only=True, eq=False)
@@ -29,6 +30,7 @@ class Context:
     mission: Mission
     surroundings: Surroundings
     spots: Spots
+    traffic: Traffic
     energy: EnergyModel
     clock: Callable[[], float]  # monotonic mission seconds: task durations (scaled by speed-up)
     wall: Callable[[], float]  # mission seconds: plan times (WaitTask.until_s)

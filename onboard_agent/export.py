@@ -21,6 +21,7 @@ from onboard_agent.energy import EnergyModel
 from onboard_agent.mission import Mission
 from onboard_agent.spots import Spots
 from onboard_agent.surroundings import Surroundings
+from onboard_agent.traffic import Traffic
 from proto.fleet import Fleet, UavType
 from proto.geo import GeoPoint
 from proto.scenario import Scenario
@@ -42,6 +43,7 @@ def exportable_tree() -> Behaviour:
         mission=Mission("uav", site, lambda: 0.0),
         surroundings=Surroundings(site),
         spots=Spots("uav", Scenario(name="any", site=site, fleet=Fleet(types=[uav_type], uavs=[]))),
+        traffic=Traffic("uav"),
         energy=EnergyModel(uav_type, 0.2),
         clock=lambda: 0.0,
         wall=lambda: 0.0,

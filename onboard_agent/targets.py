@@ -37,6 +37,7 @@ class Target:
     settle: bool = False  # near only once hovering (to grab, release or land)
     cleared: Callable[[Context], bool] = lambda _ctx: True  # may the UAV go on once near?
     cruise_z: Callable[[Context], float | None] = lambda _ctx: None  # height to cross at
+    keep_clear: Callable[[Context], bool] = lambda _ctx: True  # hold off while another UAV is there
 
     def distance(self, ctx: Context, point: Point) -> float:
         here = ctx.vehicle.position
@@ -97,6 +98,17 @@ def monitor_slot(ctx: Context) -> Point | None:
     early = task.end_s > 0 and ctx.wall() < task.end_s - task.duration_s
     radius = task.standoff_m + (ctx.config.handover_hold_m if early else 0.0)
     return _ring_point(ctx, task, radius)
+
+
+def _not_handing_over(ctx: Context) -> bool:
+    """Whether a UAV at the head segment's slot is in the way: not in the
+    first ``handover_grace_s`` of the segment's window, when the UAV it
+    relieves is due to leave (the traffic report lags by seconds)."""
+    task = ctx.mission.head
+    if not isinstance(task, MonitorTask) or task.end_s <= 0:
+        return True
+    start = task.end_s - task.duration_s
+    return not start <= ctx.wall() < start + ctx.config.handover_grace_s
 
 
 def wait_aside(ctx: Context) -> Point | None:
@@ -197,11 +209,22 @@ def station_target(pick: Callable[[Context], ChargingStation | None]) -> Target:
     def radius(ctx: Context) -> float:
         return ctx.config.near_station_m
 
-    return Target("Charging Station", locate, radius, True, cleared=cleared, cruise_z=cruise_z)
+    # a spot is granted to one UAV at a time, and each UAV holds at a height of its own
+    return Target(
+        "Charging Station",
+        locate,
+        radius,
+        True,
+        cleared=cleared,
+        cruise_z=cruise_z,
+        keep_clear=lambda _ctx: False,
+    )
 
 
 WAYPOINT = Target("WP", waypoint, lambda c: c.config.near_waypoint_m)
-HUMAN_SLOT = Target("Human Target", monitor_slot, lambda c: c.config.near_slot_m)
+HUMAN_SLOT = Target(
+    "Human Target", monitor_slot, lambda c: c.config.near_slot_m, keep_clear=_not_handing_over
+)
 WAIT_ASIDE = Target("Aside", wait_aside, lambda c: c.config.near_slot_m)
 HUMAN_DROP = Target("Human Target", drop_point, lambda c: c.config.near_human_m, settle=True)
 TOOL_STATION = Target("Station", pick_point, lambda c: c.config.near_tool_station_m, settle=True)

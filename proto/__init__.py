@@ -106,6 +106,8 @@ from proto.telemetry import (
     OutcomeResult,
     TaskOutcome,
     Telemetry,
+    Traffic,
+    TrafficEntry,
 )
 
 __all__ = [
@@ -202,6 +204,8 @@ __all__ = [
     "Tool",
     "ToolStation",
     "Tower",
+    "Traffic",
+    "TrafficEntry",
     "UavOpState",
     "UavSpec",
     "UavState",

@@ -7,6 +7,7 @@
     linecrew/{site}/station/{station}/spots
     linecrew/{site}/gs/rpc/{op}
     linecrew/{site}/gs/events
+    linecrew/{site}/gs/traffic
     linecrew/{site}/alive/{role}/{id}
     linecrew/{site}/sim/{topic}
 
@@ -57,7 +58,7 @@ def check_id(value: str, what: str = "id") -> str:
 
 class ParsedKey(msgspec.Struct, frozen=True):
     """A key split into its parts: ``kind`` is ``uav``, ``human``,
-    ``station``, ``rpc``, ``events``, ``alive`` or ``sim``; ``ident`` the UAV /
+    ``station``, ``rpc``, ``events``, ``traffic``, ``alive`` or ``sim``; ``ident`` the UAV /
     worker / station / op / id; ``topic`` the per-UAV topic, the liveliness
     role, or the sim topic."""
 
@@ -122,6 +123,10 @@ class KeySpace:
         """The ground-station event stream."""
         return f"{self.prefix}/gs/events"
 
+    def traffic(self) -> str:
+        """Where the ground station last heard each UAV (for keeping clear)."""
+        return f"{self.prefix}/gs/traffic"
+
     def alive(self, role: Role, ident: str) -> str:
         """The liveliness token of ``ident`` in ``role``."""
         return f"{self.prefix}/alive/{Role(role)}/{check_id(ident)}"
@@ -161,6 +166,8 @@ class KeySpace:
                 return ParsedKey(self.site, "rpc", check_id(op, "rpc op"))
             case ["gs", "events"]:
                 return ParsedKey(self.site, "events")
+            case ["gs", "traffic"]:
+                return ParsedKey(self.site, "traffic")
             case ["alive", role, ident] if role in set(Role):
                 return ParsedKey(self.site, "alive", check_id(ident), role)
             case ["sim", topic]:

@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import enum
 
-from proto.base import Count, Fraction, Id, Message, NonNegative
+from proto.base import Count, Fraction, Id, Message, NonNegative, Record
 from proto.geo import GeoPoint, Point, Vector
 
 
@@ -36,6 +36,23 @@ class Telemetry(Message, frozen=True, kw_only=True):
     armed: bool = False
     mode: str = ""
     tool: Id | None = None
+
+
+class TrafficEntry(Record, frozen=True, kw_only=True):
+    """One UAV as the ground station last heard it, ``age_s`` before the
+    report was sent."""
+
+    uav_id: Id
+    position: Point
+    airborne: bool
+    age_s: NonNegative = 0.0
+
+
+class Traffic(Message, frozen=True, kw_only=True):
+    """Where the fleet's UAVs are, from the ground station twice a second
+    on ``gs/traffic``: agents keep clear of points another UAV hovers at."""
+
+    uavs: list[TrafficEntry] = []
 
 
 class AgentState(enum.StrEnum):

@@ -25,6 +25,10 @@ class GoNear(AgentBehaviour):
     straight line passes near a person, the next leg round them: see
     :mod:`onboard_agent.route`), re-sent every ``goto_resend_s`` and
     whenever it moved more than ``follow_threshold_m`` (a walking worker).
+    While the traffic report has another airborne UAV within
+    ``keep_clear_m`` of the target point, it holds where it is instead (at
+    most ``yield_max_s``): a point is flown to once it is free (not for
+    targets that keep UAVs apart otherwise: see ``Target.keep_clear``).
 
     A refused or unanswered mode change, arm or takeoff is retried after a
     backoff (``retry_backoff_s``, doubling up to ``retry_backoff_max_s``), up
@@ -44,6 +48,7 @@ class GoNear(AgentBehaviour):
         self._retry_at = -1e18
         self._refused = ""
         self._waiting_since: float | None = None
+        self._yield_since: float | None = None
 
     def initialise(self) -> None:
         self.command.cancel()
@@ -51,6 +56,7 @@ class GoNear(AgentBehaviour):
         self._sent = None
         self._refusals, self._retry_at, self._refused = 0, -1e18, ""
         self._waiting_since = None
+        self._yield_since = None
         self.failure_code, self.retryable = "", False
 
     def update(self) -> Status:
@@ -148,6 +154,8 @@ class GoNear(AgentBehaviour):
             self.feedback_message = "setting GUIDED"
             return Status.RUNNING
         now = ctx.clock()
+        if self._yielding(point, now):
+            return Status.RUNNING
         clear_m = ctx.surroundings.site.safety.people_clearance_m + config.route_margin_m
         people = ctx.surroundings.people()
         leg = route.next_leg(vehicle.position, point, people, clear_m, self.target.cruise_z(ctx))
@@ -158,6 +166,30 @@ class GoNear(AgentBehaviour):
         distance = self.target.distance(ctx, point)
         self.feedback_message = f"flying to {self.target.label}, {distance:.1f} m"
         return Status.RUNNING
+
+    def _yielding(self, point: Point, now: float) -> bool:
+        """Hold where the UAV is while another airborne UAV is at ``point``
+        (from the traffic report), for at most ``yield_max_s``."""
+        ctx, config = self.ctx, self.ctx.config
+        radius = max(config.keep_clear_m, ctx.surroundings.site.safety.separation_m)
+        here = ctx.vehicle.position
+        other = None
+        if here.distance_to(point) >= radius and self.target.keep_clear(ctx):
+            other = ctx.traffic.holder(point, radius, ctx.link_clock())
+        if other is None:
+            self._yield_since = None
+            return False
+        if self._yield_since is None:
+            self._yield_since = now
+            self._sent = None
+        if now - self._yield_since > config.yield_max_s:
+            return False  # it has not moved for long: fly on (the plan knows no better)
+        if self._sent is None or now - self._sent_at >= config.goto_resend_s:
+            self._sent = self._sent or here
+            ctx.autopilot.goto(self._sent)
+            self._sent_at = now
+        self.feedback_message = f"holding off: {other} is at the {self.target.label}"
+        return True
 
     def terminate(self, new_status: Status) -> None:
         if new_status is Status.INVALID:

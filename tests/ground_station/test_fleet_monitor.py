@@ -134,3 +134,15 @@ def test_an_agent_not_ready_takes_no_work_until_it_is_ready():
     monitor.on_status(AgentStatus(uav_id="u1", stamp_s=1, state=AgentState.IDLE))
     assert monitor.check(1.5) == [("u1", Change.BACK)]  # ready: it gets work again
     assert monitor.available("u1")
+
+
+def test_traffic_says_where_each_uav_was_heard_and_for_how_long_lost_ones_too():
+    monitor = FleetMonitor(["u1", "u2", "u3", "u4"], 5.0)
+    present(monitor, "u1", 10.0)
+    monitor.on_telemetry(telemetry("u2", FlightState.LANDED), 10.0)
+    present(monitor, "u3", 0.0)  # silent since: lost, but may hover on where it was
+    monitor.check(10.0)
+    report = monitor.traffic(12.0)
+    entries = {e.uav_id: (e.airborne, e.age_s) for e in report.uavs}
+    assert entries == {"u1": (True, 2.0), "u2": (False, 2.0), "u3": (True, 12.0)}  # u4: never heard
+    assert [e.uav_id for e in monitor.traffic(75.0).uavs] == []  # all older than a minute

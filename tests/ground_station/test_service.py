@@ -36,6 +36,7 @@ from proto import (
     Role,
     SubmitAction,
     TaskOutcome,
+    Traffic,
     UavTopic,
 )
 from proto.errors import LinecrewError
@@ -150,6 +151,15 @@ def test_a_new_action_reaches_the_capable_agent(client, agents):
         "the pick task at uav-1",
     )
     assert owner_of(agents, "deliver-wrench") is uav1
+
+
+def test_the_ground_station_tells_agents_where_every_uav_is(client, agents):
+    reports: list[Traffic] = []
+    client.subscribe(KEYS.traffic(), Traffic, lambda _key, report: reports.append(report))
+    wait_until(lambda: reports and len(reports[-1].uavs) == len(agents), 10, "a traffic report")
+    entry = next(e for e in reports[-1].uavs if e.uav_id == "uav-1")
+    assert entry.position == agents["uav-1"].position and not entry.airborne
+    assert entry.age_s < 1.0  # heard 5 times a second
 
 
 def test_brief_drop_out_changes_nothing_and_a_long_one_moves_the_work(client, agents):

@@ -1,5 +1,6 @@
 """The agent on a real router: resync by query, epoch fencing on the plan
-key, outcomes held while no ground station is alive, telemetry and status."""
+key, outcomes held while no ground station is alive, telemetry and status,
+the traffic report."""
 
 from __future__ import annotations
 
@@ -8,9 +9,10 @@ import time
 
 from linecrew.bus import Bus
 from onboard_agent.comms import Comms
+from proto.geo import Point
 from proto.keys import KeySpace, Role
 from proto.rpc import GetPlans, PlansReply
-from proto.telemetry import AgentStatus, TaskOutcome, Telemetry
+from proto.telemetry import AgentStatus, TaskOutcome, Telemetry, Traffic, TrafficEntry
 from tests.onboard_agent.helpers import Rig, inspect_task, plan
 
 KEYS = KeySpace("default")
@@ -69,6 +71,13 @@ def test_comms_round_trip(bus_config):
             await until(lambda: got["outcome"], what="outcome delivered")
             assert got["outcome"][0].task_id == "new" and got["outcome"][0].epoch == 8
             await until(lambda: got["telemetry"] and got["status"], what="telemetry and status")
+
+            there = Point(x_m=1.0, y_m=2.0, z_m=5.0)
+            report = Traffic(uavs=[TrafficEntry(uav_id="uav-2", position=there, airborne=True)])
+            gs_bus.publish(KEYS.traffic(), report)
+            traffic = rig.agent.ctx.traffic
+            await until(lambda: traffic.holder(there, 1.0, rig.clock()), what="traffic report")
+            assert traffic.holder(there, 1.0, rig.clock()) == "uav-2"
             running.cancel()
             token.close()
 

@@ -10,7 +10,7 @@ import pytest
 from ground_station.planner.validate import WAIT_ASIDE_M
 from proto.geo import GeoPoint
 from proto.plan import MonitorTask, WaitTask
-from proto.telemetry import HumanPose, OutcomeResult
+from proto.telemetry import HumanPose, OutcomeResult, Traffic, TrafficEntry
 from tests.onboard_agent.helpers import SCENARIO, Rig, plan, point
 
 W2 = SCENARIO.site.worker("W2").position  # (-5, 15, 3)
@@ -121,3 +121,57 @@ def test_a_wait_that_follows_no_segment_holds_where_it_is():
     rig.agent.offer_plan(plan(WaitTask(task_id="w1", until_s=rig.wall() + 3.0)))
     rig.run_until(lambda: rig.mission.head is None)
     assert not [name for name, _ in rig.autopilot.calls if name == "goto"]
+
+
+def _traffic_at(rig, where, airborne=True):
+    report = Traffic(
+        uavs=[TrafficEntry(uav_id="uav-2", position=where, airborne=airborne, age_s=0.2)]
+    )
+    rig.agent.ctx.traffic.update(report, rig.clock())
+
+
+def test_the_slot_is_flown_to_only_once_the_uav_hovering_there_has_left():
+    rig = Rig()
+    rig.agent.offer_plan(plan(monitor(slot=0, slots=1, duration_s=3.0)))
+    slot = point(W2.x_m + 4.0, W2.y_m, W2.z_m + 3.0)
+    rig.run_until(lambda: rig.leaf() == "Go near Human Target", arrive=False)
+    rig.tick(5, arrive=False)  # airborne now, on its way
+    _traffic_at(rig, point(slot.x_m + 0.5, slot.y_m, slot.z_m))  # uav-2 hovers at the slot
+    rig.tick(3, arrive=False)
+    held = last_goto(rig)
+    assert held.distance_to(slot) > 2.0  # holding off where it was, not at the slot
+    feedback = [
+        n.feedback_message for n in rig.agent.root.iterate() if n.name.startswith("Go near")
+    ]
+    assert "holding off: uav-2 is at the Human Target" in feedback
+    _traffic_at(rig, point(slot.x_m + 0.5, slot.y_m, slot.z_m), airborne=False)  # it landed
+    rig.run_until(lambda: rig.leaf() == "Monitoring")
+    assert rig.autopilot.state.position.distance_to(slot) < 0.1
+    rig.run_until(lambda: rig.mission.head is None)
+    [outcome] = rig.outcomes()
+    assert outcome.result is OutcomeResult.COMPLETED
+
+
+def test_a_uav_that_never_leaves_the_point_is_waited_for_at_most_yield_max_s():
+    rig = Rig()
+    rig.agent.offer_plan(plan(monitor(slot=0, slots=1, duration_s=3.0)))
+    slot = point(W2.x_m + 4.0, W2.y_m, W2.z_m + 3.0)
+    rig.run_until(lambda: rig.leaf() == "Go near Human Target", arrive=False)
+    rig.tick(5, arrive=False)
+    _traffic_at(rig, slot)
+    started = rig.clock()
+    rig.run_until(lambda: rig.leaf() == "Monitoring")
+    assert rig.clock() - started >= rig.agent.ctx.config.yield_max_s
+
+
+def test_a_relief_closes_in_at_its_window_though_the_uav_it_relieves_still_shows_there():
+    rig = Rig()
+    start = rig.wall() + 5.0
+    task = msgspec.structs.replace(
+        monitor(slot=0, slots=1, duration_s=30.0), start_s=rig.wall(), end_s=start + 30.0
+    )
+    rig.agent.offer_plan(plan(task))
+    slot = point(W2.x_m + 4.0, W2.y_m, W2.z_m + task.height_m)
+    _traffic_at(rig, slot)  # the relieved UAV, as the (lagging) report last heard it
+    rig.run_until(lambda: rig.wall() >= start + 0.5)
+    assert last_goto(rig).distance_to(slot) < 0.1  # its turn: it closes in all the same

@@ -60,8 +60,13 @@ def service_rules(name: str) -> list[dict]:
             rule("gs-sub", IN, ["declare_subscriber"], uav_in),
             rule("gs-sub-data", OUT, ["put", "delete"], uav_in),
             # plans to agents, the event stream
-            rule("gs-pub", IN, ["put", "delete"], ["uav/*/plan", "gs/events"]),
-            rule("gs-pub-interest", OUT, ["declare_subscriber"], ["uav/*/plan", "gs/events"]),
+            rule("gs-pub", IN, ["put", "delete"], ["uav/*/plan", "gs/events", "gs/traffic"]),
+            rule(
+                "gs-pub-interest",
+                OUT,
+                ["declare_subscriber"],
+                ["uav/*/plan", "gs/events", "gs/traffic"],
+            ),
             # agents' health; its own token
             rule(
                 "gs-watch",
@@ -129,8 +134,9 @@ def service_rules(name: str) -> list[dict]:
 def agent_rules(uav: str) -> list[dict]:
     """An onboard agent (onboard_agent/comms.py): publishes its own telemetry,
     status, outcomes and spot claims; reads its own plan (subscription and
-    resync query), the workers' poses, the stations' spots and the ground
-    stations' tokens; declares its token."""
+    resync query), the workers' poses, the stations' spots, the ground
+    station's traffic report and the ground stations' tokens; declares its
+    token."""
     own_out = [
         f"uav/{uav}/telemetry",
         f"uav/{uav}/status",
@@ -138,6 +144,7 @@ def agent_rules(uav: str) -> list[dict]:
         f"uav/{uav}/spot",
     ]
     plan = f"uav/{uav}/plan"
+    feeds = ["human/*/pose", "station/*/spots", "gs/traffic"]
     # The router tells a client which subscribers match what it publishes, and
     # a client stops sending puts when it knows of none: "*-interest" rules let
     # those declarations out (measured: without them publications stop after
@@ -153,13 +160,8 @@ def agent_rules(uav: str) -> list[dict]:
             ["declare_subscriber"],
             ["uav/*/telemetry", "uav/*/status", "uav/*/outcome", "uav/*/spot"],
         ),
-        rule(f"{uav}-sub", IN, ["declare_subscriber"], [plan, "human/*/pose", "station/*/spots"]),
-        rule(
-            f"{uav}-sub-data",
-            OUT,
-            ["put", "delete"],
-            [plan, "human/*/pose", "station/*/spots"],
-        ),
+        rule(f"{uav}-sub", IN, ["declare_subscriber"], [plan, *feeds]),
+        rule(f"{uav}-sub-data", OUT, ["put", "delete"], [plan, *feeds]),
         rule(f"{uav}-plan-query", IN, ["query"], [plan]),
         rule(f"{uav}-plan-reply", OUT, ["reply"], [plan]),
         rule(f"{uav}-gs-alive", IN, ["declare_liveliness_subscriber"], ["alive/gs/*"]),

@@ -1,0 +1,44 @@
+"""Where the other UAVs are, as the ground station last heard them
+(``gs/traffic``), so that the agent never flies to a point another UAV
+hovers at: the last line of separation after the plan's own (hold points
+taken in turn, distinct slots, spots) when a plan is stale or a UAV hangs.
+
+Ages are in real seconds (the link clock), whatever the mission's speed-up.
+Without a report (the ground station is away) nothing is known: the agent
+flies its plan as before.
+"""
+
+from __future__ import annotations
+
+from proto.geo import Point
+from proto.telemetry import Traffic as TrafficReport
+
+STALE_S = 60.0
+"""A report entry older than this (as heard by the ground station, plus the
+time since the report came) is forgotten."""
+
+
+class Traffic:
+    """The latest traffic report, with when it came."""
+
+    def __init__(self, uav_id: str) -> None:
+        self.uav_id = uav_id
+        self._report: TrafficReport | None = None
+        self._received_s = 0.0
+
+    def update(self, report: TrafficReport, now_s: float) -> None:
+        """Keep ``report`` (received at ``now_s`` of the link clock)."""
+        self._report, self._received_s = report, now_s
+
+    def holder(self, point: Point, radius_m: float, now_s: float) -> str | None:
+        """Another airborne UAV within ``radius_m`` of ``point``, if any (the nearest)."""
+        if self._report is None:
+            return None
+        since = now_s - self._received_s
+        near = [
+            (e.position.distance_to(point), e.uav_id)
+            for e in self._report.uavs
+            if e.airborne and e.uav_id != self.uav_id and e.age_s + since <= STALE_S
+        ]
+        near = [n for n in near if n[0] < radius_m]
+        return min(near)[1] if near else None
