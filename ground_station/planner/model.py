@@ -8,6 +8,7 @@ metres in the site's local ENU frame, ``_s`` seconds on the problem's clock,
 
 from __future__ import annotations
 
+from math import cos, pi, radians, sin
 from typing import Literal
 
 import msgspec
@@ -125,6 +126,24 @@ class MonitorAction(msgspec.Struct, frozen=True, kw_only=True, tag="monitor", ta
     """A synchronised start already promised to the UAVs: kept whenever it
     is still feasible, so that a replan does not move a start the fleet is
     waiting for (which would wait again, and again)."""
+
+
+WAIT_ASIDE_M = 3.0
+"""A UAV that waits airborne after a monitoring segment hovers this far
+along the ring (counter-clockwise) from its slot, clear of its relief."""
+
+
+def slot_position(a: MonitorAction, slot: int, aside_m: float = 0.0) -> Vec3:
+    """Stand-off position of ``slot`` (bearing ``bearing_deg`` + 360*slot/k
+    degrees, ``height_m`` above the worker), ``aside_m`` along the ring."""
+    x, y, z = a.worker_m
+    ang = radians(a.bearing_deg) + 2 * pi * slot / a.k
+    r = a.standoff_m
+    return (
+        x + r * cos(ang) - aside_m * sin(ang),
+        y + r * sin(ang) + aside_m * cos(ang),
+        z + a.height_m,
+    )
 
 
 class DeliverAction(msgspec.Struct, frozen=True, kw_only=True, tag="deliver", tag_field="kind"):

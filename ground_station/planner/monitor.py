@@ -12,11 +12,11 @@ at their start time; the UAV that left recharges in its own route.
 from __future__ import annotations
 
 import heapq
-from math import cos, dist, pi, radians, sin
+from math import dist
 
 from ground_station.planner import costs
 from ground_station.planner.energy import EPS_S
-from ground_station.planner.model import MonitorAction, Vec3
+from ground_station.planner.model import MonitorAction, Vec3, slot_position
 from ground_station.planner.routes import Ctx
 from ground_station.planner.simulate import Task, monitor_reach
 
@@ -37,14 +37,6 @@ SHUFFLE_P = 0.2
 """Improvement only: the chance that segment candidates are tried in random order."""
 RANDOM_T0 = 2
 """Improvement only: random start times added to the candidates."""
-
-
-def slot_position(a: MonitorAction, slot: int) -> Vec3:
-    """Stand-off position of ``slot``: bearing ``bearing_deg`` + 360*slot/k
-    degrees, ``height_m`` above the worker."""
-    x, y, z = a.worker_m
-    ang = radians(a.bearing_deg) + 2 * pi * slot / a.k
-    return (x + a.standoff_m * cos(ang), y + a.standoff_m * sin(ang), z + a.height_m)
 
 
 def _cover(ctx: Ctx, a: MonitorAction, t0: float, uids: list[str]) -> float | None:

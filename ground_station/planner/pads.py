@@ -143,6 +143,19 @@ class Pads:
             self.slots[si] = [r for r in self.slots[si] if r != gone]
         del mine[i:j]
 
+    def merge(self, merged: int, joined: int) -> None:
+        """Move resource ``merged``'s reservations to ``joined`` (hold points
+        that a new point linked into one group)."""
+        moved = self.slots.pop(merged, None)
+        if not moved:
+            return
+        self.slots[joined] = sorted([*self.slots.get(joined, _NONE), *moved])
+        self.longest[joined] = max(self.longest.get(joined, 0.0), self.longest.pop(merged))
+        for uid in {u for _, _, u in moved}:
+            self.by_uav[uid] = sorted(
+                (s, e, joined if si == merged else si) for s, e, si in self.by_uav[uid]
+            )
+
     def add(self, si: int, start_s: float, end_s: float, uav_id: str) -> None:
         lst = list(self.slots.get(si, _NONE))  # a new list: copies share the old one
         insort(lst, (start_s, end_s, uav_id))

@@ -42,8 +42,8 @@ from ground_station.planner.model import (
     Uav,
     UavType,
     Vec3,
+    slot_position,
 )
-from ground_station.planner.monitor import slot_position
 from ground_station.planner.result import Plan, Step, UavPlan
 
 SEGMENTS = 3

@@ -15,9 +15,8 @@ from collections.abc import Callable
 from math import dist
 
 from ground_station.planner.energy import EPS_S, EPS_WH, energy_after_recharge
-from ground_station.planner.model import Vec3
 from ground_station.planner.routes import Ctx
-from ground_station.planner.simulate import HOLDS, State, Task
+from ground_station.planner.simulate import HOLDS, State, Task, hold_wait
 
 
 def remove_in_place(ctx: Ctx, uid: str, pred: Callable[[Task], bool]) -> list[Task] | None:
@@ -37,6 +36,7 @@ def remove_in_place(ctx: Ctx, uid: str, pred: Callable[[Task], bool]) -> list[Ta
     tasks: list[Task] = []
     res: list[tuple[int, float, float]] = []
     removed: list[Task] = []
+    mine = (uid, -1e18)  # this route's own bookings are being redone
     last_kept = max((i for i, x in enumerate(r.tasks) if not pred(x)), default=-1)
     open_mark: int | None = None
     for i in range(n):
@@ -70,7 +70,7 @@ def remove_in_place(ctx: Ctx, uid: str, pred: Callable[[Task], bool]) -> list[Ta
             if new_start > t + EPS_S:  # idle where we are until it is time to go
                 if not landed:
                     e -= k.hover_whps * (new_start - t)
-                    if not _hold(ctx, uid, pos, t, new_start, res):
+                    if not hold_wait(ctx.site, ctx.pads, pos, t, new_start, mine, res):
                         return None
                 steps.append(("wait", t, t, new_start, e, pos, None, None, None, None, 0.0))
             e -= d * k.wh_per_m
@@ -88,7 +88,7 @@ def remove_in_place(ctx: Ctx, uid: str, pred: Callable[[Task], bool]) -> list[Ta
                 landed = landed or p in stations
                 if not landed:
                     e -= k.hover_whps * (end - arrive)
-                    if not _hold(ctx, uid, p, arrive, end, res):
+                    if not hold_wait(ctx.site, ctx.pads, p, arrive, end, mine, res):
                         return None
             else:
                 e -= k.hover_whps * (end - arrive)
@@ -113,15 +113,3 @@ def remove_in_place(ctx: Ctx, uid: str, pred: Callable[[Task], bool]) -> list[Ta
     for si, s, e2 in res:
         ctx.pads.add(si, s, e2, uid)
     return removed
-
-
-def _hold(ctx: Ctx, uid: str, pos: Vec3, start: float, end: float, res: list) -> bool:
-    """Reserve an airborne wait at ``pos`` if that is a hold point; False if
-    another UAV holds it then."""
-    point = ctx.site.points.get(pos)
-    if point is None or end - start <= EPS_S:
-        return True
-    if ctx.pads.earliest(point, start, end - start, (uid, -1e18)) > start + EPS_S:
-        return False
-    res.append((point, start, end))
-    return True

@@ -149,6 +149,11 @@ class Session:
         for a in queue_order(actions):
             heuristic.place_action(self.ctx, a)
 
+    def _hold_points(self, a: Action) -> None:
+        """Register ``a``'s hold points; bookings of groups it merges move along."""
+        for merged, joined in self.ctx.site.points.add_action(a):
+            self.ctx.pads.merge(merged, joined)
+
     # -- events -------------------------------------------------------------------
     def apply(self, event: Event) -> Plan:
         """Apply one event; returns the new plan. Raises ``PlanningProblemError``
@@ -161,7 +166,7 @@ class Session:
                     raise PlanningProblemError("$.event.action.id", f"duplicate id {a.id!r}")
                 self._set_problem(replace(self.problem, actions=(*self.problem.actions, a)))
                 check_problem(self.problem)
-                self.ctx.site.points.add_action(a)
+                self._hold_points(a)
                 self._place([a])
             case ActionChanged(action=a):
                 self._require_action(a.id)
@@ -169,7 +174,7 @@ class Session:
                 acts = tuple(a if x.id == a.id else x for x in self.problem.actions)
                 self._set_problem(replace(self.problem, actions=acts))
                 check_problem(self.problem)
-                self.ctx.site.points.add_action(a)
+                self._hold_points(a)
                 self._place([a])
             case ActionCancelled(action_id=aid):
                 self._require_action(aid)

@@ -29,6 +29,20 @@ HOLDS = frozenset({"inspect", "pick", "deliver"})
 UAV waits until the first has left (an airborne wait there holds it too)."""
 
 
+def hold_wait(
+    site: Site, pads: Pads, pos: Vec3, start: float, end: float, ign: Ignore, res: list
+) -> bool:
+    """Book an airborne wait at ``pos`` in ``res`` if that is a hold point
+    (hovering on there, it stays taken); False if another UAV holds it then."""
+    point = site.points.get(pos)
+    if point is None or end - start <= EPS_S:
+        return True
+    if pads.earliest(point, start, end - start, ign) > start + EPS_S:
+        return False
+    res.append((point, start, end))
+    return True
+
+
 def _service_end_e(k: Kin, e_at: float, service_s: float) -> float:
     return e_at - k.hover_whps * service_s
 
@@ -116,11 +130,8 @@ def advance(
             later = task.released(free)
             return advance(k, site, pads, st0, later, steps, res, ign, depth + 1, soft)
     if wait > EPS_S:
-        here = None if st.landed else site.points.get(pos)
-        if here is not None:  # hovering on at a hold point: it stays taken
-            if pads.earliest(here, t, wait, ign) > t + EPS_S:
-                return "point_busy"
-            res.append((here, t, t + wait))
+        if not st.landed and not hold_wait(site, pads, pos, t, t + wait, ign, res):
+            return "point_busy"
         steps.append(("wait", t, t, t + wait, e_wait, pos, None, None, None, None, 0.0))
     end = arr + service
     steps.append(

@@ -45,41 +45,33 @@ class Task:
         self.topup = False  # recharge before this task if at all possible
         self.full_s: float | None = None  # a running task's full service, if resumed later
 
-    def copy_topup(self) -> Task:
-        t = Task(
-            self.kind,
-            self.action_id,
-            self.index,
-            self.pos,
-            self.service_s,
-            self.release_s,
-            self.anchor_s,
-            self.tool,
-        )
-        t.topup = True
-        t.full_s = self.full_s
-        return t
-
-    def released(self, release_s: float) -> Task:
-        """This task, not to be started before ``release_s``."""
-        t = self.copy_topup()
-        t.topup, t.release_s = self.topup, release_s
-        return t
-
-    def resumed(self) -> Task:
-        """This running task redone in full (after a recharge or interruption)."""
-        if self.full_s is None:
-            return self
+    def _with(self, service_s: float, release_s: float) -> Task:
         return Task(
             self.kind,
             self.action_id,
             self.index,
             self.pos,
-            self.full_s,
-            self.release_s,
+            service_s,
+            release_s,
             self.anchor_s,
             self.tool,
         )
+
+    def copy_topup(self) -> Task:
+        """This task, recharging before it if at all possible."""
+        t = self._with(self.service_s, self.release_s)
+        t.topup, t.full_s = True, self.full_s
+        return t
+
+    def released(self, release_s: float) -> Task:
+        """This task, not to be started before ``release_s``."""
+        t = self._with(self.service_s, release_s)
+        t.topup, t.full_s = self.topup, self.full_s
+        return t
+
+    def resumed(self) -> Task:
+        """This running task redone in full (after a recharge or interruption)."""
+        return self if self.full_s is None else self._with(self.full_s, self.release_s)
 
     def __repr__(self) -> str:
         return f"Task({self.kind},{self.action_id},{self.index},{self.anchor_s})"

@@ -12,16 +12,19 @@ from __future__ import annotations
 from collections import defaultdict
 from math import cos, dist, pi, radians, sin
 
-from ground_station.planner.model import DeliverAction, InspectAction, MonitorAction, Problem
+from ground_station.planner.model import (
+    WAIT_ASIDE_M,
+    DeliverAction,
+    InspectAction,
+    MonitorAction,
+    Problem,
+)
 from ground_station.planner.result import Plan, Violation
 
 TOL_S = 1e-3
 TOL_WH = 1e-3
 TOL_M = 0.01
 STANDOFF_TOL_M = 0.5
-WAIT_ASIDE_M = 3.0
-"""The agents' rule: an airborne wait right after a monitoring segment
-hovers this far along the ring from the slot (``AgentConfig.wait_aside_m``)."""
 SERVICE_KIND = {"inspect": "inspect", "monitor": "monitor", "pick": "deliver", "deliver": "deliver"}
 KIND_OF = {InspectAction: "inspect", MonitorAction: "monitor", DeliverAction: "deliver"}
 
