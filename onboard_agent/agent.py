@@ -162,6 +162,7 @@ class Agent:
             queue_length=len(self.mission.tasks),
             reason=reason,
             ready=not self.not_ready() and state is not AgentState.FAILED,
+            holding_for=self.ctx.holding_for,
         )
 
     def status_changed(self, status: AgentStatus) -> bool:
@@ -174,6 +175,7 @@ class Agent:
             status.queue_length,
             status.reason,
             status.ready,
+            status.holding_for,
             tuple(status.active_path),
         )
         changed = key != self._last_status

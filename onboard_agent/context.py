@@ -38,6 +38,7 @@ class Context:
     tool_station_id: str | None = None  # where that tool was picked
     recharging: bool = False  # a battery-low recharge runs until the battery is full
     emergency: str = ""  # why the emergency protocol is active ("" when not)
+    holding_for: str | None = None  # the UAV at our next point: we hold until it leaves
     link_clock: Callable[[], float] = time.monotonic  # real seconds: link timeouts
 
     @property

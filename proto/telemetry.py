@@ -79,6 +79,9 @@ class AgentStatus(Message, frozen=True, kw_only=True):
     queue_length: Count = 0
     reason: str = ""
     ready: bool = True  # False while the autopilot cannot arm (``reason`` says why)
+    holding_for: Id | None = None
+    """Another UAV at the point this one flies to next: it holds where it is
+    until that point is free (keep-clear, at most the agent's yield time)."""
 
 
 class OutcomeResult(enum.StrEnum):

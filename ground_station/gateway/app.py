@@ -30,6 +30,7 @@ from ground_station.gateway.gestures import Vocabulary
 from ground_station.gateway.metrics import GatewayCounters, prometheus_text
 from ground_station.gateway.rpc import GsClient, to_json
 from ground_station.gateway.settings import GatewaySettings
+from ground_station.gateway.workers import WorkerPoses
 from proto.errors import LinecrewError, RequestTimeout
 from proto.mission import Action, ActionState
 from proto.rpc import (
@@ -63,9 +64,14 @@ def is_public(path: str) -> bool:
 
 
 def create_app(
-    settings: GatewaySettings, client: GsClient, site: Site, vocabulary: Vocabulary
+    settings: GatewaySettings,
+    client: GsClient,
+    site: Site,
+    vocabulary: Vocabulary,
+    workers: WorkerPoses,
 ) -> FastAPI:
-    """The gateway application over ``client``."""
+    """The gateway application over ``client``; ``workers`` holds the
+    tracked poses of the site's people."""
     app = FastAPI(
         title="linecrew gateway",
         version="1",
@@ -252,6 +258,13 @@ def create_app(
     @app.get("/v1/site", summary="The site: towers, lines, stations, tool stations, workers")
     async def get_site() -> Response:
         return json(site)
+
+    @app.get(
+        "/v1/workers",
+        summary="Where each worker is now (tracked poses; the site's position until one arrives)",
+    )
+    async def get_workers() -> Response:
+        return json(workers.reply())
 
     @app.get("/healthz", summary="Gateway liveness and whether the ground station is up")
     async def healthz() -> Response:

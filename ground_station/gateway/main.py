@@ -12,11 +12,13 @@ from ground_station.gateway.app import create_app
 from ground_station.gateway.gestures import Vocabulary
 from ground_station.gateway.rpc import GsClient
 from ground_station.gateway.settings import GatewaySettings, resolve_token
+from ground_station.gateway.workers import WorkerPoses
 from linecrew.bus import Bus
 from linecrew.process import common_parser, start
 from linecrew.scenarios import ScenarioError, load
 from proto.errors import Unavailable
 from proto.keys import KeySpace, Role
+from proto.telemetry import HumanPose
 
 log = logging.getLogger("linecrew.gateway")
 
@@ -51,7 +53,9 @@ def main(argv: list[str] | None = None) -> int:
     with bus:
         bus.declare_token(KeySpace(settings.site).alive(Role.GATEWAY, "gateway"))
         client = GsClient(bus, settings.site, settings.rpc_timeout_s)
-        app = create_app(settings, client, scenario.site, vocabulary)
+        workers = WorkerPoses(scenario.site)
+        bus.subscribe(client.keys.all_human_poses(), HumanPose, workers.on_pose)
+        app = create_app(settings, client, scenario.site, vocabulary, workers)
         server = uvicorn.Server(
             uvicorn.Config(
                 app, host=settings.host, port=settings.port, log_config=None, access_log=False

@@ -39,6 +39,8 @@ def fleet_table(uavs: list[dict[str, Any]]) -> Table:
         pos = tel.get("position")
         silent, control = u.get("silent_s"), u.get("control")
         state = f"{u['state']} (silent {silent:.0f} s)" if silent else u["state"]
+        if status.get("holding_for"):
+            state += f", holding off for {status['holding_for']}"
         table.add_row(
             u["uav_id"],
             f"{state}, operator: {control}" if control else state,

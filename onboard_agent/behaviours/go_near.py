@@ -177,13 +177,15 @@ class GoNear(AgentBehaviour):
         if here.distance_to(point) >= radius and self.target.keep_clear(ctx):
             other = ctx.traffic.holder(point, radius, ctx.link_clock())
         if other is None:
-            self._yield_since = None
+            self._yield_since = ctx.holding_for = None
             return False
         if self._yield_since is None:
             self._yield_since = now
             self._sent = None
         if now - self._yield_since > config.yield_max_s:
+            ctx.holding_for = None
             return False  # it has not moved for long: fly on (the plan knows no better)
+        ctx.holding_for = other
         if self._sent is None or now - self._sent_at >= config.goto_resend_s:
             self._sent = self._sent or here
             ctx.autopilot.goto(self._sent)
@@ -192,5 +194,6 @@ class GoNear(AgentBehaviour):
         return True
 
     def terminate(self, new_status: Status) -> None:
+        self.ctx.holding_for = None
         if new_status is Status.INVALID:
             self.command.cancel()

@@ -15,9 +15,11 @@ import time
 from collections.abc import Iterator
 from typing import Any
 
+import msgspec
 import uvicorn
 
 from ground_station.gateway import GatewaySettings, Vocabulary, create_app
+from ground_station.gateway.workers import WorkerPoses
 from linecrew.bus.router_process import free_port
 from proto import KeySpace
 from proto.events import EventKind, GsEvent
@@ -43,7 +45,7 @@ from proto.rpc import (
 )
 from proto.sim import FaultApplied, SimFault
 from proto.site import ChargingStation, Line, Site, Tool, ToolStation, Tower, Worker
-from proto.telemetry import AgentState, AgentStatus, FlightState, Telemetry
+from proto.telemetry import AgentState, AgentStatus, FlightState, HumanPose, Telemetry
 
 TOKEN = "fake-fleet-token"
 
@@ -125,6 +127,7 @@ class FakeFleet:
                 epoch=self.epoch(),
                 task_id=f"{uav_id}.t{self.epoch()}.0",
                 progress=(now % 30) / 30,
+                holding_for=self.ids[0] if i == 1 else None,  # uav-2 waits for uav-1's point
             )
             out.append(
                 UavState(uav_id=uav_id, state=UavOpState.BUSY, telemetry=telemetry, status=status)
@@ -271,7 +274,13 @@ def fake_app(uavs: int = 50, rate_hz: float = 5.0, site: Site | None = None):
     site = site or big_site()
     client = FakeClient(FakeFleet(site, uavs, rate_hz))
     settings = GatewaySettings(token=TOKEN, site=site.id)
-    return create_app(settings, client, site, Vocabulary.load()), client  # type: ignore[arg-type]
+    workers = WorkerPoses(site)
+    first = site.workers[0]  # tracked 3 m east of where the site puts them; the rest untracked
+    moved = msgspec.structs.replace(first.position, x_m=first.position.x_m + 3.0)
+    pose = HumanPose(worker_id=first.id, stamp_s=time.time(), position=moved, geo=GeoPoint())
+    workers.on_pose(KeySpace(site.id).human_pose(first.id), pose)
+    app = create_app(settings, client, site, Vocabulary.load(), workers)  # type: ignore[arg-type]
+    return app, client
 
 
 @contextlib.contextmanager

@@ -327,3 +327,29 @@ def test_a_lost_uav_raises_a_critical_alert_keyed_by_its_event(run, new_page, ga
         f"#fleet tr[data-uav='{uav}'][data-state=failed]"
     ).first.wait_for()
     assert not log.errors, log.errors
+
+
+def test_a_worker_who_moves_is_drawn_where_the_tracker_sees_them(run, new_page, gateway, artefacts):
+    page, log = open_console(new_page, run)
+    wait_loaded(page)
+    worker = PAPER.site.workers[0]
+    start = worker.position
+    page.locator(f"#map .worker[data-id='{worker.id}']:not(.untracked)").wait_for()
+    there = {"x_m": start.x_m + 6.0, "y_m": start.y_m - 4.0, "z_m": start.z_m}
+    body = {"type": "move_worker", "worker_id": worker.id, "position": there}
+    gateway.call("POST", "/v1/sim/faults", json=body)
+    try:
+        page.wait_for_function(
+            "([id, x, y]) => { const e = document.querySelector(`#map .worker[data-id='${id}']`);"
+            " return e && Math.hypot(+e.dataset.x - x, +e.dataset.y - y) < 0.01; }",
+            arg=[worker.id, there["x_m"], there["y_m"]],
+        )
+        [view] = [
+            w for w in gateway.call("GET", "/v1/workers")["workers"] if w["worker_id"] == worker.id
+        ]
+        assert view["tracked"] and view["position"]["x_m"] == there["x_m"]
+        shoot(page, artefacts, "worker-moved")
+    finally:
+        back = {"x_m": start.x_m, "y_m": start.y_m, "z_m": start.z_m}
+        gateway.call("POST", "/v1/sim/faults", json={**body, "position": back})
+    assert not log.errors, log.errors

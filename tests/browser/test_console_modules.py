@@ -10,7 +10,7 @@ import pytest
 
 from linecrew.fault_kinds import FAULT_KINDS
 from proto.sim import SimFault
-from tests.browser.fake_fleet import TOKEN, fake_app, serving
+from tests.browser.fake_fleet import TOKEN, big_site, fake_app, serving
 
 
 @pytest.fixture(scope="module")
@@ -91,3 +91,22 @@ def _values(body: dict) -> list[float]:
     if "position" in body:
         return [body["position"][k] for k in ("x_m", "y_m", "z_m")]
     return [body[k] for k in ("fraction", "multiplier", "duration_s") if k in body]
+
+
+def test_workers_are_drawn_where_tracked_and_a_uav_holding_off_says_for_whom(page):
+    site = big_site()
+    first, second = site.workers[:2]
+    page.locator(f"#map .worker[data-id='{first.id}']:not(.untracked)").wait_for()
+    where = page.eval_on_selector_all(
+        "#map .worker",
+        "els => Object.fromEntries(els.map(e => [e.dataset.id, [+e.dataset.x, +e.dataset.y]]))",
+    )
+    assert where[first.id] == [first.position.x_m + 3.0, first.position.y_m]  # the tracked pose
+    assert where[second.id] == [second.position.x_m, second.position.y_m]  # the site's, faded
+    assert page.locator(f"#map .worker.untracked[data-id='{second.id}']").count() == 1
+    title = page.text_content(f"#map .worker[data-id='{first.id}'] title")
+    assert "tracked" in title and "not tracked" not in title
+    page.locator("#map .uav.holding[data-uav='uav-2']").wait_for()
+    assert page.locator("#map .uav.holding").count() == 1
+    state = page.text_content("#fleet tr[data-uav='uav-2'] .c-state")
+    assert state == "busy · holding off for uav-1"

@@ -27,10 +27,11 @@ import pytest
 from linecrew import health
 from linecrew.bus import Bus, BusConfig
 from proto.errors import RequestTimeout, Unavailable
+from proto.geo import GeoPoint, Point
 from proto.keys import KeySpace, Role
 from proto.plan import Plan
 from proto.rpc import GetPlans, PlansReply
-from proto.telemetry import AgentState, AgentStatus
+from proto.telemetry import AgentState, AgentStatus, HumanPose
 from tests.support.processes import free_port, port_open, running, wait_until
 
 ROOT = pathlib.Path(__file__).resolve().parents[2]
@@ -316,6 +317,29 @@ def test_gateway_reaches_the_ground_station_but_cannot_write_the_fleet(pki, endp
         open_as(pki, endpoint, "uav-1") as uav,
     ):
         asyncio.run(scenario(gs, gateway, uav))
+
+
+def test_the_gateway_reads_the_workers_poses_and_the_operator_the_uavs_reports(pki, endpoint):
+    """What the console's map and the run's flight log need, under the ACL."""
+    with (
+        open_as(pki, endpoint, "sim") as sim,
+        open_as(pki, endpoint, "uav-1") as uav,
+        open_as(pki, endpoint, "gateway") as gateway,
+        open_as(pki, endpoint, "operator") as operator,
+    ):
+        poses, reports = Inbox(), Inbox()
+        gateway.subscribe(KEYS.all_human_poses(), HumanPose, poses)
+        operator.subscribe(KEYS.all_uavs("status"), AgentStatus, reports)
+        pose_key, status_key = KEYS.human_pose("W1"), KEYS.status("uav-1")
+        pose = HumanPose(
+            worker_id="W1", stamp_s=1.0, position=Point(x_m=1.0, y_m=2.0), geo=GeoPoint()
+        )
+        deadline = time.monotonic() + 10
+        while poses.count(pose_key) < 3 or reports.count(status_key) < 3:
+            assert time.monotonic() < deadline, (poses.count(pose_key), reports.count(status_key))
+            sim.publish(pose_key, pose)
+            uav.publish(status_key, status("uav-1"))
+            time.sleep(0.05)
 
 
 # -- the files -----------------------------------------------------------------------------------

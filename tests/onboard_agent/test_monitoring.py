@@ -144,8 +144,10 @@ def test_the_slot_is_flown_to_only_once_the_uav_hovering_there_has_left():
         n.feedback_message for n in rig.agent.root.iterate() if n.name.startswith("Go near")
     ]
     assert "holding off: uav-2 is at the Human Target" in feedback
+    assert rig.agent.status().holding_for == "uav-2"  # the operator sees why it waits
     _traffic_at(rig, point(slot.x_m + 0.5, slot.y_m, slot.z_m), airborne=False)  # it landed
     rig.run_until(lambda: rig.leaf() == "Monitoring")
+    assert rig.agent.status().holding_for is None
     assert rig.autopilot.state.position.distance_to(slot) < 0.1
     rig.run_until(lambda: rig.mission.head is None)
     [outcome] = rig.outcomes()
@@ -160,8 +162,11 @@ def test_a_uav_that_never_leaves_the_point_is_waited_for_at_most_yield_max_s():
     rig.tick(5, arrive=False)
     _traffic_at(rig, slot)
     started = rig.clock()
+    rig.tick(3, arrive=False)
+    assert rig.agent.status().holding_for == "uav-2"
     rig.run_until(lambda: rig.leaf() == "Monitoring")
     assert rig.clock() - started >= rig.agent.ctx.config.yield_max_s
+    assert rig.agent.status().holding_for is None  # it flew on: no longer holding off
 
 
 def test_a_relief_closes_in_at_its_window_though_the_uav_it_relieves_still_shows_there():

@@ -82,8 +82,9 @@ def service_rules(name: str) -> list[dict]:
         return [
             rule("gateway-call", IN, ["query"], ["gs/rpc/*", "sim/fault"]),
             rule("gateway-call-replies", OUT, ["reply"], ["gs/rpc/*", "sim/fault"]),
-            rule("gateway-events", IN, ["declare_subscriber"], ["gs/events"]),
-            rule("gateway-events-data", OUT, ["put", "delete"], ["gs/events"]),
+            # the event stream, and the workers' poses for the console's map
+            rule("gateway-events", IN, ["declare_subscriber"], ["gs/events", "human/*/pose"]),
+            rule("gateway-events-data", OUT, ["put", "delete"], ["gs/events", "human/*/pose"]),
             rule(
                 "gateway-gs-alive",
                 IN,
@@ -113,13 +114,15 @@ def service_rules(name: str) -> list[dict]:
         ]
     if name == "operator":
         # CLI tools, `linecrew up/demo`'s watcher, benchmarks: read and ask, never publish
-        # as a fleet member (no put, no token, no queryable)
+        # as a fleet member (no put, no token, no queryable); it reads the events and
+        # the UAVs' reports (the run's flight log)
         calls = ["gs/rpc/*", "sim/fault", "sim/state"]
+        feeds = ["gs/events", "uav/*/telemetry", "uav/*/status", "uav/*/outcome"]
         return [
             rule("operator-call", IN, ["query"], calls),
             rule("operator-call-replies", OUT, ["reply"], calls),
-            rule("operator-events", IN, ["declare_subscriber"], ["gs/events"]),
-            rule("operator-events-data", OUT, ["put", "delete"], ["gs/events"]),
+            rule("operator-events", IN, ["declare_subscriber"], feeds),
+            rule("operator-events-data", OUT, ["put", "delete"], feeds),
             rule(
                 "operator-alive",
                 IN,

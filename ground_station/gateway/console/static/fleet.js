@@ -44,6 +44,14 @@ async function command(path, button, name = button.dataset.command) {
   }
 }
 
+/** The UAV's state, with what keeps it waiting: silence, another UAV at its next point. */
+export function stateText(uav) {
+  let said = uav.silent_s ? `${uav.state} (silent ${Math.round(uav.silent_s)} s)` : uav.state;
+  const other = uav.status && uav.status.holding_for;
+  if (other) said += ` · holding off for ${other}`;
+  return said;
+}
+
 function render(s) {
   const ids = byId(s.fleet.keys());
   for (const id of ids) {
@@ -54,7 +62,7 @@ function render(s) {
     const task = currentTask(id);
     const plan = s.plans.get(id);
     text(c.uav, id);
-    text(c.state, uav.silent_s ? `${uav.state} (silent ${Math.round(uav.silent_s)} s)` : uav.state);
+    text(c.state, stateText(uav));
     row.node.dataset.state = uav.state;
     text(c.flight, t ? `${t.flight_state}${t.mode ? ` ${t.mode}` : ""}` : "-");
     text(c.battery, t ? pct(t.battery_fraction) : "-");

@@ -1,7 +1,7 @@
 // Boot: token, views, polling and the live event stream.
 //
-// The fleet is polled (default every 500 ms; #poll=MS in the URL changes
-// it), plans and actions are fetched on the events that change them and
+// The fleet and the workers' poses are polled (default every 500 ms;
+// #poll=MS in the URL changes it), plans and actions are fetched on the events that change them and
 // polled slowly as a fallback. Every update only marks views dirty; they
 // render together in the next animation frame.
 
@@ -13,7 +13,18 @@ import { initFleet } from "./fleet.js";
 import { initGantt } from "./gantt.js";
 import { initMap } from "./map.js";
 import { initSim } from "./sim.js";
-import { clockRate, invalidate, missionNow, setActions, setFleet, setPlans, setSite, state, stats } from "./store.js";
+import {
+  clockRate,
+  invalidate,
+  missionNow,
+  setActions,
+  setFleet,
+  setPlans,
+  setSite,
+  setWorkers,
+  state,
+  stats,
+} from "./store.js";
 
 const $ = (id) => document.getElementById(id);
 const params = readFragment();
@@ -98,6 +109,7 @@ function setQuality(q) {
   el.textContent = `objective ${q.objective_s.toFixed(1)} s, ${ago}`;
   el.dataset.objective = String(q.objective_s);
 }
+const refreshWorkers = () => quietly(async () => setWorkers((await api("GET", "v1/workers")).workers));
 const refreshActions = () => quietly(async () => setActions(await api("GET", "v1/actions")));
 const plansSoon = later(refreshPlans, 100);
 const actionsSoon = later(refreshActions, 100);
@@ -129,6 +141,7 @@ async function start() {
   }
   document.body.dataset.ready = "yes";
   every(POLL_MS, refreshFleet, gen);
+  every(POLL_MS, refreshWorkers, gen);
   every(3000, refreshPlans, gen);
   every(2000, refreshActions, gen);
   stream = followEvents(

@@ -1,10 +1,10 @@
 // The site map: SVG in local ENU metres (x east, y north: drawn as -y so
 // north is up), auto-fitted to the site and the UAVs. Static features are
-// drawn once per fit; UAVs, routes, tracks and waypoints are kept by id
-// and updated in place.
+// drawn once per fit; UAVs, workers (where the tracker sees them), routes,
+// tracks and waypoints are kept by id and updated in place.
 
 import { attr, el, Keyed, pct, text, toggle } from "./dom.js";
-import { currentTask, onRender, select, state, taskTargets } from "./store.js";
+import { currentTask, onRender, select, state, taskTargets, workerPosition } from "./store.js";
 
 let svg;
 let layers;
@@ -30,6 +30,7 @@ export function initMap(node) {
   layers.routeItems = new Keyed(layers.routes, (id) =>
     el("svg:polyline", { class: "route", "data-uav": id }),
   );
+  layers.workerItems = new Keyed(layers.workers, makeWorker);
   layers.wpItems = new Keyed(layers.waypoints, () => {
     const node = el("svg:circle", { class: "wp" });
     el("svg:title", {}, node);
@@ -52,10 +53,19 @@ function makeUav(id) {
   return { node, body, label, sub, title };
 }
 
+function makeWorker(id) {
+  const node = el("svg:g", { class: "worker", "data-id": id });
+  el("svg:circle", { r: 0.8 }, node);
+  el("svg:text", { x: 1.1, y: 0.4, text: id }, node);
+  const title = el("svg:title", {}, node);
+  return { node, title };
+}
+
 function render(s) {
   if (!s.site) return;
   fit(s);
   drawStatic(s);
+  drawWorkers(s);
   drawWaypoints(s);
   drawUavs(s);
 }
@@ -70,9 +80,8 @@ function bounds(s) {
     ys.push(-p.y_m);
   };
   const site = s.site;
-  for (const f of [...site.towers, ...site.stations, ...site.tool_stations, ...site.workers]) {
-    add(f.position);
-  }
+  for (const f of [...site.towers, ...site.stations, ...site.tool_stations]) add(f.position);
+  for (const w of site.workers) add(workerPosition(w.id));
   for (const uav of s.fleet.values()) if (uav.telemetry) add(uav.telemetry.position);
   if (!xs.length) return { x: -10, y: -10, w: 20, h: 20 };
   const x0 = Math.min(...xs);
@@ -105,7 +114,7 @@ function drawStatic(s) {
   const key = `${unit}|${JSON.stringify([...stock])}`;
   if (key === staticKey) return;
   staticKey = key;
-  for (const name of ["lines", "stations", "tools", "towers", "workers"]) {
+  for (const name of ["lines", "stations", "tools", "towers"]) {
     layers[name].replaceChildren();
   }
   const towers = new Map(site.towers.map((t) => [t.id, t]));
@@ -138,12 +147,25 @@ function drawStatic(s) {
     el("svg:text", { x: 0.6, y: -0.6, transform: "rotate(-60)", text: tools.join(", ") }, g);
     el("svg:title", { text: `tool station ${ts.id}: ${tools.join(", ")} (left/total)` }, g);
   }
-  for (const w of site.workers) {
-    const g = group(layers.workers, w.position, "worker", w.id);
-    el("svg:circle", { r: 0.8 }, g);
-    el("svg:text", { x: 1.1, y: 0.4, text: w.id }, g);
-    el("svg:title", { text: `worker ${w.id} (start position, z ${round(w.position.z_m)} m)` }, g);
+}
+
+// -- workers ---------------------------------------------------------------------------
+
+function drawWorkers(s) {
+  const keep = new Set();
+  for (const w of s.site.workers) {
+    keep.add(w.id);
+    const item = layers.workerItems.get(w.id);
+    const live = s.workers.get(w.id);
+    const p = live ? live.position : w.position;
+    attr(item.node, "transform", `translate(${pt(p)}) scale(${round(unit)})`);
+    attr(item.node, "data-x", p.x_m);
+    attr(item.node, "data-y", p.y_m);
+    toggle(item.node, "untracked", !(live && live.tracked));
+    const seen = live && live.tracked ? `tracked ${live.age_s.toFixed(1)} s ago` : "not tracked: site position";
+    text(item.title, `worker ${w.id} at ${round(p.x_m)}, ${round(p.y_m)}, z ${round(p.z_m)} m (${seen})`);
   }
+  layers.workerItems.prune(keep);
 }
 
 function group(parent, p, cls, id) {
@@ -212,7 +234,9 @@ function drawUavs(s) {
     attr(item.body, "transform", `rotate(${Math.round(t.heading_deg)})`);
     const task = currentTask(id);
     text(item.label, id);
-    text(item.sub, `${p.z_m.toFixed(1)} m · ${pct(t.battery_fraction)} · ${uav.state}`);
+    const holding = uav.status && uav.status.holding_for;
+    toggle(item.node, "holding", holding);
+    text(item.sub, `${p.z_m.toFixed(1)} m · ${pct(t.battery_fraction)} · ${holding ? `holding off for ${holding}` : uav.state}`);
     text(
       item.title,
       `${id}: ${uav.state} (${t.flight_state}, ${t.mode})\n` +

@@ -12,6 +12,7 @@ export const state = {
   plans: new Map(), // uav_id -> Plan
   actions: new Map(), // action_id -> ActionRecord
   tracks: new Map(), // uav_id -> [[x, y], ...]
+  workers: new Map(), // worker_id -> WorkerView (tracked pose, else the site's)
   selected: null, // uav_id
 };
 
@@ -131,6 +132,11 @@ export function setFleet(uavs) {
   invalidate("map", "fleet", "alerts-fleet", "sim");
 }
 
+export function setWorkers(workers) {
+  state.workers = new Map(workers.map((w) => [w.worker_id, w]));
+  invalidate("map");
+}
+
 export function setPlans(plans) {
   state.plans = new Map(plans.map((p) => [p.uav_id, p]));
   invalidate("map", "gantt", "fleet");
@@ -148,7 +154,10 @@ export function upsertAction(record) {
 
 // -- derived --------------------------------------------------------------------
 
+/** Where a worker is now: tracked, else where the site puts them. */
 export function workerPosition(id) {
+  const live = state.workers.get(id);
+  if (live) return live.position;
   const w = state.site && state.site.workers.find((x) => x.id === id);
   return w ? w.position : null;
 }
