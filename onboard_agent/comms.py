@@ -37,6 +37,15 @@ class Comms:
         self.config = agent.ctx.config
         self._last_status_at = -1e9
         self._resyncs: set[asyncio.Task[None]] = set()
+        self.refused = 0  # samples dropped: their payload names another owner than their key
+
+    def _trusted(self, key: str, kind: str, ident: str) -> bool:
+        """Whether a sample on ``key`` may speak for ``kind`` ``ident``; counts refusals."""
+        if self.keys.owns(key, kind, ident):
+            return True
+        self.refused += 1
+        log.warning("refused a sample: %s does not belong to %s %s", key, kind, ident)
+        return False
 
     async def run(self) -> None:
         """Declare the token and serve until cancelled."""
@@ -57,13 +66,14 @@ class Comms:
 
     async def _poses(self) -> None:
         async with self.bus.subscribe_async(self.keys.all_human_poses(), HumanPose) as sub:
-            async for _key, pose in sub:
-                self.agent.human_pose(pose)
+            async for key, pose in sub:
+                if self._trusted(key, "human", pose.worker_id):
+                    self.agent.human_pose(pose)
 
     async def _spots(self) -> None:
         async with self.bus.subscribe_async(self.keys.all_station_spots(), StationSpots) as sub:
             async for key, feed in sub:
-                if self.keys.owns(key, "station", feed.station_id):
+                if self._trusted(key, "station", feed.station_id):
                     self.agent.ctx.spots.update(feed, self.agent.ctx.clock())
 
     async def _traffic(self) -> None:

@@ -1,6 +1,6 @@
 """The agent on a real router: resync by query, epoch fencing on the plan
 key, outcomes held while no ground station is alive, telemetry and status,
-the traffic report."""
+the traffic report, worker poses trusted only on their own worker's key."""
 
 from __future__ import annotations
 
@@ -9,10 +9,17 @@ import time
 
 from linecrew.bus import Bus
 from onboard_agent.comms import Comms
-from proto.geo import Point
+from proto.geo import GeoPoint, Point
 from proto.keys import KeySpace, Role
 from proto.rpc import GetPlans, PlansReply
-from proto.telemetry import AgentStatus, TaskOutcome, Telemetry, Traffic, TrafficEntry
+from proto.telemetry import (
+    AgentStatus,
+    HumanPose,
+    TaskOutcome,
+    Telemetry,
+    Traffic,
+    TrafficEntry,
+)
 from tests.onboard_agent.helpers import Rig, inspect_task, plan
 
 KEYS = KeySpace("default")
@@ -78,6 +85,16 @@ def test_comms_round_trip(bus_config):
             traffic = rig.agent.ctx.traffic
             await until(lambda: traffic.holder(there, 1.0, rig.clock()), what="traffic report")
             assert traffic.holder(there, 1.0, rig.clock()) == "uav-2"
+
+            surroundings = rig.agent.ctx.surroundings
+            site_w1 = surroundings.worker_position("W1")
+            moved = Point(x_m=site_w1.x_m + 40.0, y_m=site_w1.y_m, z_m=site_w1.z_m)
+            pose = HumanPose(worker_id="W1", stamp_s=1.0, position=moved, geo=GeoPoint())
+            gs_bus.publish(KEYS.human_pose("W2"), pose)  # W2's tracker speaking for W1
+            await until(lambda: comms.refused == 1, what="spoofed pose refused")
+            assert surroundings.worker_position("W1") == site_w1
+            gs_bus.publish(KEYS.human_pose("W1"), pose)
+            await until(lambda: surroundings.worker_position("W1") == moved, what="own pose")
             running.cancel()
             token.close()
 
