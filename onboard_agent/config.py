@@ -53,6 +53,8 @@ class AgentConfig:
     command_ack_timeout_s: float = 1.0  # wait this long for a COMMAND_ACK
     command_retries: int = 3  # resend an unacknowledged command this many times
     heartbeat_timeout_s: float = 3.0  # no autopilot HEARTBEAT this long -> link lost
+    autopilot_system: int = 0  # the autopilot's MAVLink system id; 0: the first one heard
+    autopilot_component: int = 1  # its component id (MAV_COMP_ID_AUTOPILOT1)
     plan_query_timeout_s: float = 2.0  # resync query to the ground station
 
     @classmethod
@@ -84,6 +86,8 @@ class AgentConfig:
             raise ValueError("battery_full_fraction must be in (0, 1]")
         if self.agent_link_timeout_s <= 0 or self.command_ack_timeout_s <= 0:
             raise ValueError("timeouts must be positive")
+        if not 0 <= self.autopilot_system <= 255 or not 1 <= self.autopilot_component <= 255:
+            raise ValueError("autopilot_system must be 0-255, autopilot_component 1-255")
         if self.command_retries < 0:
             raise ValueError("command_retries must be >= 0")
         if self.arm_attempts < 1 or self.retry_backoff_s <= 0 or self.ready_timeout_s <= 0:

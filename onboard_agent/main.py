@@ -14,6 +14,7 @@ import logging
 import sys
 
 from linecrew import scenarios
+from linecrew.mavlink_keys import load_key
 from linecrew.process import Shutdown, common_parser, start
 from onboard_agent import export
 from onboard_agent.config import AgentConfig
@@ -31,6 +32,17 @@ def parser() -> argparse.ArgumentParser:
         "--autopilot",
         required=True,
         help="pymavlink connection string, e.g. udpout:127.0.0.1:14560, tcp:host:5760",
+    )
+    p.add_argument(
+        "--autopilot-system",
+        type=int,
+        help="the autopilot's MAVLink system id (default: the first autopilot heard)",
+    )
+    p.add_argument(
+        "--mavlink-key",
+        metavar="FILE",
+        help="sign the MAVLink link with this key file's passphrase and accept only "
+        "packets signed with it (the autopilot must hold the same key)",
     )
     p.add_argument("--scenario", default="paper", help="scenario name or YAML/JSON file")
     p.add_argument("--tick-hz", type=float, help="behaviour-tree ticks per second (10)")
@@ -59,8 +71,13 @@ def main(argv: list[str] | None = None) -> int:
     args = parser().parse_args(argv)
     bus_config = start(args, "agent")
     try:
-        config = AgentConfig.from_env(tick_hz=args.tick_hz, agent_link_timeout_s=args.link_timeout)
+        config = AgentConfig.from_env(
+            tick_hz=args.tick_hz,
+            agent_link_timeout_s=args.link_timeout,
+            autopilot_system=args.autopilot_system,
+        )
         scenario = scenarios.load(args.scenario, site=args.site)
+        signing_key = load_key(args.mavlink_key) if args.mavlink_key else None
     except (ValueError, LinecrewError) as exc:
         log.error("cannot start: %s", exc)
         return 2
@@ -77,6 +94,7 @@ def main(argv: list[str] | None = None) -> int:
                 stop,
                 scenario.site.id,
                 args.speedup,
+                signing_key,
             )
         )
     except LinecrewError as exc:

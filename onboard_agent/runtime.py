@@ -45,12 +45,14 @@ async def run_agent(
     stop: Awaitable[None],
     site: str | None = None,
     speedup: float = 1.0,
+    signing_key: bytes | None = None,
 ) -> None:
     """Fly ``uav_id`` until ``stop`` completes; then stop ticking and close
     the bus and the MAVLink link. Keys use ``site`` (default: the scenario's).
     Task durations and plan times run on the mission clock (``speedup``);
-    link timeouts on real time."""
-    link = MavlinkLink(autopilot_url, LocalFrame(scenario.site.origin), config)
+    link timeouts on real time. With ``signing_key`` the MAVLink link is signed."""
+    frame = LocalFrame(scenario.site.origin)
+    link = MavlinkLink(autopilot_url, frame, config, signing_key=signing_key)
     agent = Agent(
         uav_id,
         scenario,

@@ -23,7 +23,7 @@ import contextlib
 import logging
 import threading
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from typing import TypeVar
 
@@ -44,6 +44,7 @@ class FleetConfig:
     host: str = "127.0.0.1"  # address the endpoints bind to
     base_port: int = 14560  # vehicle i (0-based) listens on base_port + i; 0: any free port
     static_peers: tuple[Addr, ...] = ()  # always sent telemetry (SITL "udpclient")
+    signing_keys: Mapping[str, bytes] = field(default_factory=dict)  # vehicle id -> MAVLink key
     rates: TelemetryRates = field(default_factory=TelemetryRates)
     params: AutopilotParams = field(default_factory=AutopilotParams)
     physics_step_s: float = 0.05  # fixed physics step, simulated seconds
@@ -84,7 +85,11 @@ class Fleet:
             for i, (vid, vehicle) in enumerate(self.world.vehicles.items()):
                 port = cfg.base_port + i if cfg.base_port else 0
                 ep = VehicleEndpoint(
-                    self.world, vehicle, rates=cfg.rates, static_peers=cfg.static_peers
+                    self.world,
+                    vehicle,
+                    rates=cfg.rates,
+                    static_peers=cfg.static_peers,
+                    signing_key=cfg.signing_keys.get(vid),
                 )
                 transport, _ = await self._loop.create_datagram_endpoint(
                     lambda ep=ep: ep, local_addr=(cfg.host, port)

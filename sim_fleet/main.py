@@ -14,6 +14,7 @@ import logging
 import sys
 
 from linecrew.bus import Bus
+from linecrew.mavlink_keys import SigningKeyError, key_path, load_key
 from linecrew.process import Shutdown, common_parser, start
 from linecrew.scenarios import ScenarioError, load
 from proto.errors import Unavailable
@@ -64,6 +65,13 @@ async def serve(
     return 0
 
 
+def signing_keys(directory: str | None, uav_ids: list[str]) -> dict[str, bytes]:
+    """Every vehicle's MAVLink key from ``directory`` (none without one)."""
+    if directory is None:
+        return {}
+    return {uav_id: load_key(key_path(directory, uav_id)) for uav_id in uav_ids}
+
+
 def main(argv: list[str] | None = None) -> int:
     """Run until SIGINT/SIGTERM; exit 1 on a fatal start-up error.
     ``linecrew sim fault ...`` injects a fault into a running simulator."""
@@ -95,6 +103,12 @@ def main(argv: list[str] | None = None) -> int:
         action="store_true",
         help="stream telemetry before any client asks (ArduCopter with SRx_ rates set)",
     )
+    parser.add_argument(
+        "--mavlink-keys",
+        metavar="DIR",
+        help="sign MAVLink with each vehicle's key DIR/{uav}.key and accept only signed "
+        "packets (the secured profile writes them)",
+    )
     args = parser.parse_args(argv)
     if args.warmup_s < 0:
         parser.error("--warmup-s must be >= 0")
@@ -102,8 +116,9 @@ def main(argv: list[str] | None = None) -> int:
     shutdown = Shutdown().install()
     try:
         scenario = load(args.scenario, site=args.site)
+        keys = signing_keys(args.mavlink_keys, [u.id for u in scenario.fleet.uavs])
         bus = Bus.open(bus_config, should_stop=shutdown.is_set)
-    except (ScenarioError, Unavailable) as exc:
+    except (ScenarioError, SigningKeyError, Unavailable) as exc:
         log.error("simulator cannot start: %s", exc)
         return 1
     config = FleetConfig(
@@ -112,6 +127,7 @@ def main(argv: list[str] | None = None) -> int:
         host=args.host,
         params=AutopilotParams(warmup_s=args.warmup_s),
         rates=TelemetryRates(stream_by_default=args.stream_by_default),
+        signing_keys=keys,
     )
     fleet = Fleet(scenario_from_proto(scenario.site, scenario.fleet), config)
     with bus:

@@ -13,6 +13,16 @@ This is the only pymavlink importer in ``sim_fleet``. Untrusted bytes never
 raise out of here: each datagram gets a fresh parser (MAVLink over UDP puts
 whole packets in a datagram, so garbage cannot eat the next one), and bad
 datagrams are counted and logged once per source.
+
+Signing: given a key, the endpoint signs everything it sends and acts only on
+packets signed with that key (MAVLink 2 signing, as ArduPilot does once a key
+is set); anything else is counted in ``rejected`` and never makes a peer.
+Replays are refused by the signature's timestamp (one signing state per
+endpoint, shared by every datagram's parser).
+
+Peers: a learned peer heard within ``PEER_LIVE_S`` keeps its place, so a
+flood of strangers cannot push the agent out of the table; a newcomer finds
+room only when a peer has gone quiet (counted in ``refused_peers``).
 """
 
 from __future__ import annotations
@@ -27,6 +37,7 @@ from typing import Any, cast
 os.environ["MAVLINK20"] = "1"  # for any mavutil user in this process; we use the v20 dialect
 from pymavlink.dialects.v20 import ardupilotmega as mav
 
+from linecrew.mavlink_keys import signing_timestamp
 from sim_fleet import autopilot, frames, streams
 from sim_fleet.events import Outcome, Result, Severity
 from sim_fleet.modes import LANDED_STATE, base_mode, system_status
@@ -37,6 +48,7 @@ log = logging.getLogger(__name__)
 
 AUTOPILOT_COMPONENT = 1
 MAX_LEARNED_PEERS = 8
+PEER_LIVE_S = 5.0  # a peer heard this recently is never displaced by a newcomer
 POS_IGNORE = 0b111
 VEL_IGNORE = 0b111000
 # AUTOPILOT_VERSION: ArduCopter 4.5.0 official
@@ -68,6 +80,7 @@ class VehicleEndpoint(asyncio.DatagramProtocol):
         *,
         rates: streams.TelemetryRates | None = None,
         static_peers: tuple[Addr, ...] = (),
+        signing_key: bytes | None = None,
     ) -> None:
         self.world = world
         self.vehicle = vehicle
@@ -75,8 +88,15 @@ class VehicleEndpoint(asyncio.DatagramProtocol):
         self.static_peers = tuple(static_peers)
         self.peers: dict[Addr, float] = {}  # learned peer -> last heard (monotonic)
         self.bad_datagrams = 0
+        self.rejected = 0  # packets not signed with our key (signing on)
+        self.refused_peers = 0  # newcomers turned away while the table was full of live peers
         self._logged_bad: set[str] = set()
         self._mav = mav.MAVLink(None, srcSystem=vehicle.sysid, srcComponent=AUTOPILOT_COMPONENT)
+        self._signing = signing_key is not None
+        if signing_key is not None:
+            sign = self._mav.signing
+            sign.secret_key, sign.sign_outgoing = signing_key, True
+            sign.timestamp = signing_timestamp()
         self._home_sent = 0  # the vehicle's home_version last broadcast
         self._transport: asyncio.DatagramTransport | None = None
 
@@ -98,13 +118,17 @@ class VehicleEndpoint(asyncio.DatagramProtocol):
         try:
             parser = mav.MAVLink(None)
             parser.robust_parsing = True
+            if self._signing:
+                parser.signing = self._mav.signing
             msgs = parser.parse_buffer(data) or []
         except Exception as exc:  # untrusted bytes: any decoder failure is a bad datagram
             self._bad(addr, repr(exc))
             return
         for msg in msgs:
             if msg.get_type() == "BAD_DATA":
-                self._bad(addr, "bad data")
+                if self._signing and msg.reason == "Invalid signature":
+                    self.rejected += 1
+                self._bad(addr, msg.reason)
                 continue
             self._learn(addr)
             try:
@@ -119,10 +143,14 @@ class VehicleEndpoint(asyncio.DatagramProtocol):
             log.warning("%s: dropping bad datagram from %s: %s", self.vehicle.id, addr, why)
 
     def _learn(self, addr: Addr) -> None:
-        self.peers[addr] = time.monotonic()
-        if len(self.peers) > MAX_LEARNED_PEERS:
+        now = time.monotonic()
+        if addr not in self.peers and len(self.peers) >= MAX_LEARNED_PEERS:
             oldest = min(self.peers, key=self.peers.__getitem__)
+            if now - self.peers[oldest] < PEER_LIVE_S:
+                self.refused_peers += 1  # still answered directly, just not streamed to
+                return
             del self.peers[oldest]
+        self.peers[addr] = now
 
     # ---- incoming --------------------------------------------------------
     def _for_me(self, msg: Any) -> bool:
@@ -188,6 +216,8 @@ class VehicleEndpoint(asyncio.DatagramProtocol):
     def _command(self, cmd: autopilot.Command, msg: Any, addr: Addr) -> None:
         p = cmd.params
         match cmd.command:
+            case mav.MAV_CMD_SET_MESSAGE_INTERVAL if autopilot.as_int(p[0]) == streams.HEARTBEAT:
+                outcome = Outcome(Result.DENIED, "Heartbeat rate is fixed")  # the link's pulse
             case mav.MAV_CMD_SET_MESSAGE_INTERVAL:
                 ok = self.schedule.set_interval(autopilot.as_int(p[0]), p[1])
                 text = None if ok else f"No ap_message for mavlink id ({autopilot.as_int(p[0])})"

@@ -13,6 +13,8 @@
 #   zenoh/router.json5, zenoh/client-<identity>.json5
 #                                   configs with absolute paths into OUT_DIR
 #                                   (deploy/zenoh/secure/render.py)
+#   mavlink/uav-K.key               each vehicle's MAVLink 2 signing passphrase
+#                                   (agent --mavlink-key, sim --mavlink-keys)
 #
 # Idempotent: the CA and every existing certificate are kept; only what is
 # missing is created (a larger N adds the new UAVs, signed by the same CA).
@@ -44,7 +46,7 @@ umask 077
 mkdir -p "$OUT"
 OUT=$(cd "$OUT" && pwd)
 if [ "${FORCE:-0}" = 1 ]; then
-    rm -f "$OUT"/*.pem "$OUT"/*.key "$OUT"/*.srl "$OUT"/zenoh/*.json5
+    rm -f "$OUT"/*.pem "$OUT"/*.key "$OUT"/*.srl "$OUT"/zenoh/*.json5 "$OUT"/mavlink/*.key
 fi
 
 newkey() { # PKCS#8 EC P-256 key, what rustls reads
@@ -96,8 +98,11 @@ for identity in gs gateway sim operator; do
     client "$identity"
 done
 i=1
+mkdir -p "$OUT/mavlink"
 while [ "$i" -le "$N" ]; do
     client "uav-$i"
+    key="$OUT/mavlink/uav-$i.key"
+    [ -s "$key" ] || openssl rand -hex 24 >"$key"
     i=$((i + 1))
 done
 chmod 644 "$OUT"/*.pem

@@ -62,6 +62,7 @@ class LocalRun:
         self.endpoint = ""
         self.url = ""
         self.token = ""
+        self.mavlink_ports: dict[str, int] = {}  # UAV id -> its simulated autopilot's UDP port
         self.bus: Bus | None = None
         self.flight_log: FlightLog | None = None
         self.session_file: pathlib.Path | None = None  # where the run is registered
@@ -148,6 +149,7 @@ class LocalRun:
         sup.wait_ready(gs, lambda: self._alive(Role.GROUND_STATION, "gs"), wait)
 
         base_port = free_udp_block(len(uavs))
+        self.mavlink_ports = {uav_id: base_port + i for i, uav_id in enumerate(uavs)}
         sim = sup.start(
             "sim",
             "sim_fleet",
@@ -157,6 +159,7 @@ class LocalRun:
             "--base-port",
             str(base_port),
             *(["--warmup-s", str(opts.warmup_s)] if opts.warmup_s is not None else []),
+            *(["--mavlink-keys", profile.mavlink_keys()] if profile else []),
         )
         sup.wait_ready(sim, lambda: self._alive(Role.SIM, "sim"), wait)
 
@@ -183,7 +186,7 @@ class LocalRun:
             )
             self.session_file = session.register(entry, opts.session_file)
 
-        for index, uav_id in enumerate(uavs):
+        for uav_id in uavs:
             agent = sup.start(
                 f"agent-{uav_id}",
                 "onboard_agent",
@@ -193,7 +196,8 @@ class LocalRun:
                 "--scenario",
                 str(scenario_file),
                 "--autopilot",
-                f"udpout:127.0.0.1:{base_port + index}",
+                f"udpout:127.0.0.1:{self.mavlink_ports[uav_id]}",
+                *(["--mavlink-key", profile.mavlink_key(uav_id)] if profile else []),
             )
             sup.wait_ready(agent, lambda u=uav_id: self._alive(Role.AGENT, u), wait)
         log.info("all processes healthy", extra={"run_dir": str(self.run_dir)})

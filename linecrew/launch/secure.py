@@ -4,7 +4,8 @@ Generates a development CA, one certificate per identity and the matching
 Zenoh configs (mutual TLS, access control by certificate name) into the run
 directory with ``deploy/tls/gen-dev-ca.sh``, which needs a source checkout
 and ``openssl``. Identities: ``gs``, ``gateway``, ``sim``, ``operator`` (the
-launcher itself and the CLI tools) and ``uav-1`` .. ``uav-N``.
+launcher itself and the CLI tools) and ``uav-1`` .. ``uav-N``, each UAV also
+with a MAVLink signing key shared by its agent and the simulator.
 """
 
 from __future__ import annotations
@@ -16,6 +17,8 @@ import re
 import shutil
 import subprocess
 import sys
+
+from linecrew.mavlink_keys import key_path
 
 GEN = pathlib.Path(__file__).resolve().parents[2] / "deploy" / "tls" / "gen-dev-ca.sh"
 UAV_ID = re.compile(r"uav-(\d+)")
@@ -37,6 +40,13 @@ class SecureProfile:
     def client_config(self, identity: str) -> str:
         """The config of ``identity`` (``gs``, ``sim``, ``uav-2``, ...)."""
         return str(self.root / "zenoh" / f"client-{identity}.json5")
+
+    def mavlink_keys(self) -> str:
+        """The directory of every vehicle's MAVLink key (``uav-K.key``)."""
+        return str(self.root / "mavlink")
+
+    def mavlink_key(self, uav_id: str) -> str:
+        return str(key_path(self.mavlink_keys(), uav_id))
 
 
 def prepare(root: pathlib.Path, uav_ids: list[str]) -> SecureProfile:

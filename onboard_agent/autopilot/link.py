@@ -17,6 +17,13 @@ stop while heartbeats go on, the link asks for its telemetry by stream group
 readiness reports (SYS_STATUS, GPS_RAW_INT, EKF_STATUS_REPORT, HOME_POSITION).
 A GLOBAL_POSITION_INT of lat = lon = 0 (no EKF origin yet) or without a 3-D
 fix leaves the position unknown; the battery is unknown until reported.
+
+Only the configured autopilot is heard: a ``udpout:`` socket is connected to
+its address (the kernel drops datagrams from anyone else), messages from any
+other system or component id are dropped, and with a signing key every
+packet is signed and only packets signed with that key are accepted (MAVLink
+2 signing; replays fail on the signature's timestamp). Everything dropped is
+counted in ``dropped``.
 """
 
 from __future__ import annotations
@@ -26,6 +33,7 @@ import collections
 import dataclasses
 import logging
 import os
+import socket
 import threading
 import time
 from collections.abc import Callable
@@ -34,6 +42,7 @@ from typing import Any
 os.environ["MAVLINK20"] = "1"  # before importing mavutil: speak MAVLink 2
 from pymavlink import mavutil
 
+from linecrew.mavlink_keys import signing_timestamp
 from onboard_agent.autopilot.errors import CommandDenied, CommandTimeout, LinkLost
 from onboard_agent.autopilot.protocol import VehicleState
 from onboard_agent.config import AgentConfig
@@ -97,12 +106,15 @@ class MavlinkLink:
         clock: Callable[[], float] = time.monotonic,
         source_system: int = 255,
         source_component: int = 190,
+        signing_key: bytes | None = None,
     ) -> None:
         self.url = url
         self.frame = frame
         self.config = config
         self.clock = clock
         self._source = (source_system, source_component)
+        self._signing_key = signing_key
+        self.dropped = 0  # messages from another sender, or not signed with our key
         self._state = VehicleState()
         self._target: tuple[int, int] | None = None
         self._found: asyncio.Event | None = None
@@ -130,6 +142,13 @@ class MavlinkLink:
         self._conn = mavutil.mavlink_connection(
             self.url, source_system=system, source_component=component, autoreconnect=True
         )
+        if self._signing_key is not None:
+            self._conn.setup_signing(
+                self._signing_key, initial_timestamp=signing_timestamp(), link_id=0
+            )
+        if isinstance(self._conn, mavutil.mavudp) and not self._conn.udp_server:
+            host, port = self._conn.destination_addr  # udpout: hear only that address
+            self._conn.port.connect((socket.gethostbyname(host), port))
         self._thread = threading.Thread(target=self._receive, name="mavlink-rx", daemon=True)
         self._thread.start()
         self._send_heartbeat()  # a udpout peer learns our address from what we send
@@ -289,7 +308,11 @@ class MavlinkLink:
                     return
                 log.debug("mavlink receive failed: %s", exc)
                 continue
-            if msg is None or msg.get_type() == "BAD_DATA":
+            if msg is None:
+                continue
+            if msg.get_type() == "BAD_DATA":
+                if msg.reason == "Invalid signature":
+                    self._drop(f"unsigned or wrongly signed {msg.reason!r}")
                 continue
             try:
                 assert self._loop is not None
@@ -297,12 +320,30 @@ class MavlinkLink:
             except RuntimeError:  # the loop is closed: we are shutting down
                 return
 
+    def _drop(self, what: str) -> None:
+        """Count a message we do not act on; log the first and every 100th."""
+        self.dropped += 1
+        if self.dropped % 100 == 1:
+            log.warning("dropped MAVLink from a stranger (%d so far): %s", self.dropped, what)
+
+    def _from_autopilot(self, msg: Any) -> bool:
+        """Whether ``msg`` comes from our autopilot; counts the rest."""
+        sender = (msg.get_srcSystem(), msg.get_srcComponent())
+        if sender == self._target:
+            return True
+        if msg.get_type() == "HEARTBEAT" and msg.type == mav.MAV_TYPE_GCS:
+            return False  # another ground station on a shared link: not ours, not hostile
+        self._drop(f"{msg.get_type()} from system {sender[0]} component {sender[1]}")
+        return False
+
     def _on_message(self, msg: Any) -> None:
         kind = msg.get_type()
+        if kind == "HEARTBEAT" and self._target is None:
+            self._find(msg)
+        if self._target is None or not self._from_autopilot(msg):
+            return
         if kind == "HEARTBEAT":
             self._on_heartbeat(msg)
-            return
-        if self._target is None or msg.get_srcSystem() != self._target[0]:
             return
         s = self._state
         match kind:
@@ -377,17 +418,21 @@ class MavlinkLink:
         if changes:
             self._state = dataclasses.replace(s, **changes)
 
-    def _on_heartbeat(self, msg: Any) -> None:
+    def _find(self, msg: Any) -> None:
+        """Take the sender of ``msg`` as our autopilot if it is one we may fly."""
         if msg.type == mav.MAV_TYPE_GCS or msg.autopilot == mav.MAV_AUTOPILOT_INVALID:
             return
-        if self._target is None:
-            self._target = (msg.get_srcSystem(), msg.get_srcComponent())
-            assert self._found is not None
-            self._found.set()
-            log.info("autopilot found: system %d on %s", self._target[0], self.url)
-            self._request_streams()
-        elif msg.get_srcSystem() != self._target[0]:
+        system, component = msg.get_srcSystem(), msg.get_srcComponent()
+        wanted = self.config.autopilot_system
+        if (wanted and system != wanted) or component != self.config.autopilot_component:
             return
+        self._target = (system, component)
+        assert self._found is not None
+        self._found.set()
+        log.info("autopilot found: system %d on %s", system, self.url)
+        self._request_streams()
+
+    def _on_heartbeat(self, msg: Any) -> None:
         self._last_heartbeat = self.clock()
         armed = bool(msg.base_mode & mav.MAV_MODE_FLAG_SAFETY_ARMED)
         mode = COPTER_MODES.get(msg.custom_mode, str(msg.custom_mode))

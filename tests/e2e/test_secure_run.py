@@ -1,6 +1,7 @@
 """``linecrew up --secure``: the paper's scenario end to end with mutual TLS
 and access control on the bus (dev certificates generated into the run
-directory), and a client without a certificate kept out."""
+directory), a client without a certificate kept out, and MAVLink signed:
+a stranger on a vehicle's port is not obeyed."""
 
 from __future__ import annotations
 
@@ -12,6 +13,7 @@ from linecrew.bus import Bus, BusConfig
 from linecrew.launch.local_run import LocalRun, RunOptions
 from linecrew.launch.secure import SecureProfileError, prepare
 from tests.e2e.test_paper_mission import PAPER, RESERVE, SPEEDUP, LandingWatch, fly
+from tests.sim_fleet.mavclient import Client, mavlink
 
 pytestmark = pytest.mark.skipif(shutil.which("openssl") is None, reason="needs openssl")
 
@@ -23,6 +25,14 @@ def test_the_papers_scenario_completes_on_the_secured_bus(tmp_path):
         plain = run.endpoint.replace("tls/localhost", "tcp/127.0.0.1")
         with pytest.raises(Exception):  # noqa: B017 - zenoh raises a bare ZError
             Bus.open(BusConfig(connect=(plain,), connect_attempt_ms=500))
+        assert (run.run_dir / "tls" / "mavlink" / "uav-1.key").stat().st_mode & 0o077 == 0
+        stranger = Client(run.mavlink_ports["uav-1"], 1, streams_hz=0)
+        try:
+            arm = mavlink.MAV_CMD_COMPONENT_ARM_DISARM
+            stranger.conn.mav.command_long_send(1, 1, arm, 0, 1, 21196, 0, 0, 0, 0, 0)
+            assert stranger.conn.recv_match(blocking=True, timeout=2.0) is None  # not a word
+        finally:
+            stranger.close()
         watch = LandingWatch(run)
         records, _ = fly(run, lambda _t, _r: watch.sample())
         assert {r["action_id"]: r["state"] for r in records} == {

@@ -26,12 +26,13 @@ async def until(predicate, timeout_s: float = 10.0, what: str = "") -> None:
         await asyncio.sleep(0.01)
 
 
-def fly(fleet, uav_id: str, scenario) -> None:
-    """Run ``scenario(link)`` with a link to ``uav_id`` of the fleet."""
+def fly(fleet, uav_id: str, scenario, *, url: str | None = None, **options) -> None:
+    """Run ``scenario(link)`` with a link to ``uav_id`` of the fleet (``url``:
+    another connection string; ``options``: the link's keyword arguments)."""
 
     async def main() -> None:
-        url = f"udpout:127.0.0.1:{fleet.fleet.ports[uav_id]}"
-        link = MavlinkLink(url, LocalFrame(SITE.origin), CONFIG)
+        where = url or f"udpout:127.0.0.1:{fleet.fleet.ports[uav_id]}"
+        link = MavlinkLink(where, LocalFrame(SITE.origin), options.pop("config", CONFIG), **options)
         link.start()
         heartbeat = asyncio.create_task(link.run())
         try:
