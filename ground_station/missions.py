@@ -26,7 +26,7 @@ from ground_station.fleet_monitor import Change, FleetMonitor
 from ground_station.fleet_state import AIRBORNE
 from ground_station.lifecycle import TERMINAL, TRANSITIONS, ActionEvent
 from ground_station.monitor_bearings import as_requested, moved_off, with_bearing
-from ground_station.paging import page
+from ground_station.paging import fitting, page
 from ground_station.plan_worker import PlanWorker
 from ground_station.replan_jobs import Computed, Job, ReplanOutcome
 from ground_station.replanner import Replanner
@@ -151,7 +151,7 @@ class MissionManager:
                 chosen = [plans[uav_id]] if uav_id in plans else [] if uav_id else plans.values()
                 return PlansReply(plans=list(chosen), **self.plan_quality())
             case GetHistory(after_seq=after, limit=limit):
-                return HistoryReply(events=self.store.events(after, limit))
+                return HistoryReply(events=fitting(self.store.events(after, limit)))
         raise RequestError(f"unsupported request {type(request).__name__}")
 
     def fleet(self) -> FleetReply:

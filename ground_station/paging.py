@@ -28,12 +28,20 @@ def page(
         if cursor not in ids:
             raise RequestError(f"unknown cursor {cursor!r}", code="invalid_request", field="cursor")
         start = ids.index(cursor) + 1
+    rest = items[start:]
+    out = fitting(rest, limit)
+    return out, key(out[-1]) if len(out) < len(rest) else None
+
+
+def fitting(items: Sequence[T], limit: int | None = None) -> list[T]:
+    """The longest prefix of ``items`` (at most ``limit``, at least one item)
+    whose encoding fits ``PAGE_BYTES``."""
     out: list[T] = []
     size = 0
-    for item in items[start:]:
+    for item in items:
         n = len(msgspec.msgpack.encode(item))
         if out and (size + n > PAGE_BYTES or (limit is not None and len(out) >= limit)):
-            return out, key(out[-1])
+            break
         out.append(item)
         size += n
-    return out, None
+    return out

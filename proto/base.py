@@ -15,8 +15,13 @@ MIN_SCHEMA_VERSION = 1
 Fraction = Annotated[float, msgspec.Meta(ge=0.0, le=1.0, description="fraction 0..1")]
 NonNegative = Annotated[float, msgspec.Meta(ge=0.0)]
 Positive = Annotated[float, msgspec.Meta(gt=0.0)]
-Count = Annotated[int, msgspec.Meta(ge=0)]
-PositiveCount = Annotated[int, msgspec.Meta(ge=1)]
+MAX_INT = 2**53
+"""Integers on the wire stay below this: exact in every JSON reader's doubles."""
+Count = Annotated[int, msgspec.Meta(ge=0, le=MAX_INT)]
+PositiveCount = Annotated[int, msgspec.Meta(ge=1, le=MAX_INT)]
+Priority = Annotated[
+    float, msgspec.Meta(gt=0.0, le=1000.0, description="an action's weight, 0 < p <= 1000")
+]
 Bearing = Annotated[float, msgspec.Meta(ge=0.0, lt=360.0)]
 """Degrees counter-clockwise from the site's +x axis (east), in [0, 360)."""
 ID_PATTERN = r"^[A-Za-z0-9._-]{1,64}$"
@@ -42,4 +47,4 @@ class Message(Record, frozen=True, kw_only=True):
     field's type never changes.
     """
 
-    schema_version: int = SCHEMA_VERSION
+    schema_version: Annotated[int, msgspec.Meta(ge=0, le=65535)] = SCHEMA_VERSION

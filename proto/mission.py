@@ -4,7 +4,16 @@ from __future__ import annotations
 
 import enum
 
-from proto.base import Bearing, Fraction, Id, NonNegative, Positive, PositiveCount, Record
+from proto.base import (
+    Bearing,
+    Fraction,
+    Id,
+    NonNegative,
+    Positive,
+    PositiveCount,
+    Priority,
+    Record,
+)
 from proto.geo import Point
 
 
@@ -15,7 +24,7 @@ class ActionBase(Record, frozen=True, kw_only=True):
     ``release_s`` is the earliest start (UNIX seconds, 0 = now).
     """
 
-    priority: Positive = 1.0
+    priority: Priority = 1.0
     release_s: NonNegative = 0.0
 
 

@@ -12,7 +12,7 @@ import enum
 import typing
 from typing import ClassVar
 
-from proto.base import Count, Id, Message, Positive, PositiveCount, Record
+from proto.base import Count, Id, Message, PositiveCount, Priority, Record
 from proto.events import GsEvent
 from proto.mission import Action, ActionRecord, ActionState
 from proto.plan import Plan
@@ -41,7 +41,7 @@ class ModifyAction(RequestBase, frozen=True, kw_only=True, tag="modify"):
     op = "modify"
     request_id: str
     action_id: Id
-    priority: Positive | None = None
+    priority: Priority | None = None
     action: Action | None = None
 
 
@@ -85,7 +85,9 @@ class GetPlans(RequestBase, frozen=True, kw_only=True, tag="plans"):
 
 
 class GetHistory(RequestBase, frozen=True, kw_only=True, tag="history"):
-    """Events with ``seq > after_seq``, oldest first. Replies :class:`HistoryReply`."""
+    """Events with ``seq > after_seq``, oldest first: at most ``limit`` and
+    what fits the bus (ask again after the last one until none come).
+    Replies :class:`HistoryReply`."""
 
     op = "history"
     after_seq: Count = 0

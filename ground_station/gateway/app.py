@@ -9,14 +9,21 @@ import uuid
 from collections.abc import Awaitable, Callable
 from typing import Any
 
-import msgspec
-from fastapi import FastAPI, Request, Response
+from fastapi import FastAPI, Path, Query, Request, Response
 from fastapi.exceptions import RequestValidationError
 from fastapi.responses import PlainTextResponse, StreamingResponse
+from fastapi_offline import FastAPIOffline
 from starlette.exceptions import HTTPException
 
-from ground_station.gateway import console
-from ground_station.gateway.bodies import ControlBody, GestureBody, ModifyBody, SubmitEnvelope
+from ground_station.gateway import console, openapi
+from ground_station.gateway.bodies import (
+    ControlBody,
+    GestureBody,
+    Health,
+    ModifyBody,
+    PlanQuality,
+    SubmitEnvelope,
+)
 from ground_station.gateway.errors import (
     HttpError,
     decode_body,
@@ -25,12 +32,13 @@ from ground_station.gateway.errors import (
     linecrew_error_handler,
     validation_error_handler,
 )
-from ground_station.gateway.event_stream import event_stream
+from ground_station.gateway.event_stream import event_stream, first_history
 from ground_station.gateway.gestures import Vocabulary
 from ground_station.gateway.metrics import GatewayCounters, prometheus_text
 from ground_station.gateway.rpc import GsClient, to_json
 from ground_station.gateway.settings import GatewaySettings
 from ground_station.gateway.workers import WorkerPoses
+from proto.base import ID_PATTERN
 from proto.errors import LinecrewError, RequestTimeout
 from proto.mission import Action, ActionState
 from proto.rpc import (
@@ -52,10 +60,16 @@ from proto.rpc import (
 from proto.sim import SimFault
 from proto.site import Site
 
-PUBLIC_PATHS = ("/healthz", "/docs", "/openapi.json", "/docs/oauth2-redirect")
+PUBLIC_PATHS = ("/healthz", "/docs", "/openapi.json", "/static-offline-docs/")
 """Prefixes served without the token. The console's page (exactly ``/``) and
 its assets (``/console/...``) are public too, see :func:`console.is_public`;
 ``/`` is not a prefix here, or every path would be public."""
+
+
+MAX_PAGE = 1000  # actions per page
+MAX_SEQ = 2**63 - 1  # event sequence numbers are SQLite integers
+ACTION_ID = Path(pattern=ID_PATTERN, description="an action id, e.g. act-00001")
+UAV_ID = Path(pattern=ID_PATTERN, description="a UAV id, e.g. uav-1")
 
 
 def is_public(path: str) -> bool:
@@ -72,10 +86,11 @@ def create_app(
 ) -> FastAPI:
     """The gateway application over ``client``; ``workers`` holds the
     tracked poses of the site's people."""
-    app = FastAPI(
+    app = FastAPIOffline(  # /docs with Swagger UI's assets from the package, no CDN
         title="linecrew gateway",
         version="1",
         description="Operator API of a linecrew ground station.",
+        redoc_url=None,
     )
     counters = GatewayCounters()
     app.add_exception_handler(LinecrewError, linecrew_error_handler)
@@ -129,7 +144,7 @@ def create_app(
         "/v1/actions",
         status_code=201,
         summary="Submit an inspect, monitor or deliver action",
-        openapi_extra=_body_schema(Action),
+        openapi_extra=openapi.body_schema(Action),
     )
     async def post_action(request: Request) -> Response:
         raw = await body(request)
@@ -140,13 +155,13 @@ def create_app(
 
     @app.get("/v1/actions", summary="List actions, optionally by state, whole or by page")
     async def list_actions(
-        state: str | None = None, limit: int | None = None, cursor: str | None = None
+        state: str | None = Query(None, description="comma-separated action states"),
+        limit: int | None = Query(None, ge=1, le=MAX_PAGE),
+        cursor: str | None = Query(None, pattern=ID_PATTERN),
     ) -> Response:
         """Every action (pages fetched in turn), or with ``limit`` / ``cursor``
         one page; the ``Next-Cursor`` header then continues it."""
         states = _states(state)
-        if limit is not None and limit < 1:
-            raise HttpError("invalid_request", "limit must be >= 1", field="limit")
         if limit is not None or cursor is not None:
             request = ListActions(states=states, limit=limit, cursor=cursor)
             reply = await client.call(request, ActionList)
@@ -161,15 +176,15 @@ def create_app(
             cursor = reply.next_cursor
 
     @app.get("/v1/actions/{action_id}", summary="One action")
-    async def get_action(action_id: str) -> Response:
+    async def get_action(action_id: str = ACTION_ID) -> Response:
         return json((await client.call(GetAction(action_id=action_id), ActionReply)).record)
 
     @app.patch(
         "/v1/actions/{action_id}",
         summary="Change an action's priority or parameters",
-        openapi_extra=_body_schema(ModifyBody),
+        openapi_extra=openapi.body_schema(ModifyBody),
     )
-    async def patch_action(action_id: str, request: Request) -> Response:
+    async def patch_action(request: Request, action_id: str = ACTION_ID) -> Response:
         change = decode_body(await body(request), ModifyBody)
         modify = ModifyAction(
             request_id=change.request_id or str(uuid.uuid4()),
@@ -180,7 +195,7 @@ def create_app(
         return json((await client.call(modify, ActionReply)).record)
 
     @app.delete("/v1/actions/{action_id}", summary="Cancel an action")
-    async def delete_action(action_id: str) -> Response:
+    async def delete_action(action_id: str = ACTION_ID) -> Response:
         cancel = CancelAction(request_id=f"cancel-{action_id}", action_id=action_id)
         return json((await client.call(cancel, ActionReply)).record)
 
@@ -188,7 +203,7 @@ def create_app(
         "/v1/gestures",
         status_code=201,
         summary="Turn a crew gesture into an action",
-        openapi_extra=_body_schema(GestureBody),
+        openapi_extra=openapi.body_schema(GestureBody),
     )
     async def post_gesture(request: Request) -> Response:
         gesture = decode_body(await body(request), GestureBody)
@@ -207,15 +222,15 @@ def create_app(
     @app.post(
         "/v1/uavs/{uav_id}/control",
         summary="Take a UAV out of the plan: hold, return or land; resume gives it back",
-        openapi_extra=_body_schema(ControlBody),
+        openapi_extra=openapi.body_schema(ControlBody),
     )
-    async def control_uav(uav_id: str, request: Request) -> Response:
+    async def control_uav(request: Request, uav_id: str = UAV_ID) -> Response:
         return await control(request, uav_id)
 
     @app.post(
         "/v1/fleet/control",
         summary="Command every UAV at once (hold: a fleet stop; resume: back to the plan)",
-        openapi_extra=_body_schema(ControlBody),
+        openapi_extra=openapi.body_schema(ControlBody),
     )
     async def control_fleet(request: Request) -> Response:
         return await control(request, None)
@@ -232,24 +247,27 @@ def create_app(
     )
     async def plan_quality() -> Response:
         reply = await client.call(GetPlans(), PlansReply)
-        return json(
-            {
-                "objective_s": reply.objective_s,
-                "improved_ago_s": reply.improved_ago_s,
-                "gap_to_best": reply.gap_to_best,
-            }
+        quality = PlanQuality(
+            objective_s=reply.objective_s,
+            improved_ago_s=reply.improved_ago_s,
+            gap_to_best=reply.gap_to_best,
         )
+        return json(quality)
 
     @app.get("/v1/events", summary="Ground-station events as Server-Sent Events")
-    async def events(request: Request, after_seq: int | None = None) -> StreamingResponse:
+    async def events(
+        request: Request,
+        after_seq: int | None = Query(None, ge=0, le=MAX_SEQ, description="replay after this seq"),
+    ) -> StreamingResponse:
+        history = None if after_seq is None else await first_history(client, after_seq)
         return StreamingResponse(
-            event_stream(client, request, after_seq), media_type="text/event-stream"
+            event_stream(client, request, after_seq, history), media_type="text/event-stream"
         )
 
     @app.post(
         "/v1/sim/faults",
         summary="Inject a fault into the simulator (simulation only)",
-        openapi_extra=_body_schema(SimFault),
+        openapi_extra=openapi.body_schema(SimFault),
     )
     async def post_fault(request: Request) -> Response:
         fault = decode_body(await body(request), SimFault)
@@ -268,8 +286,7 @@ def create_app(
 
     @app.get("/healthz", summary="Gateway liveness and whether the ground station is up")
     async def healthz() -> Response:
-        up = client.ground_station_up()
-        return json({"status": "ok", "ground_station": "up" if up else "down"})
+        return json(Health(ground_station="up" if client.ground_station_up() else "down"))
 
     @app.get("/metrics", summary="Prometheus metrics", response_class=PlainTextResponse)
     async def metrics() -> PlainTextResponse:
@@ -282,14 +299,8 @@ def create_app(
         )
 
     console.mount(app)
-    _with_body_components(app)
+    openapi.install(app, is_public)
     return app
-
-
-BODY_TYPES = (Action, ModifyBody, GestureBody, ControlBody, SimFault)
-_SCHEMAS, _COMPONENTS = msgspec.json.schema_components(
-    BODY_TYPES, ref_template="#/components/schemas/{name}"
-)
 
 
 def _states(text: str | None) -> list[ActionState]:
@@ -304,21 +315,3 @@ def _states(text: str | None) -> list[ActionState]:
                 "invalid_request", f"unknown state {name!r} (one of {known})", field="state"
             ) from None
     return states
-
-
-def _body_schema(body_type: Any) -> dict[str, Any]:
-    """OpenAPI ``requestBody`` from the msgspec type (bodies are decoded by msgspec)."""
-    schema = _SCHEMAS[BODY_TYPES.index(body_type)]
-    return {"requestBody": {"required": True, "content": {"application/json": {"schema": schema}}}}
-
-
-def _with_body_components(app: FastAPI) -> None:
-    """Add the msgspec body schemas to the generated OpenAPI document."""
-    generate = app.openapi
-
-    def openapi() -> dict[str, Any]:
-        spec = generate()
-        spec.setdefault("components", {}).setdefault("schemas", {}).update(_COMPONENTS)
-        return spec
-
-    app.openapi = openapi  # type: ignore[method-assign]

@@ -1,17 +1,15 @@
-"""Shapes of the gateway's JSON request bodies (beyond the proto messages)."""
+"""Shapes of the gateway's JSON bodies beyond the proto messages: requests,
+and the replies it builds itself."""
 
 from __future__ import annotations
 
-from typing import Annotated
+from typing import Annotated, Literal
 
 import msgspec
 
-from proto.base import Id
-from proto.geo import Point
+from proto.base import Id, Priority
 from proto.mission import Action
 from proto.rpc import Command
-
-Positive = Annotated[float, msgspec.Meta(gt=0)]
 
 
 class SubmitEnvelope(msgspec.Struct, frozen=True, kw_only=True):
@@ -24,7 +22,7 @@ class SubmitEnvelope(msgspec.Struct, frozen=True, kw_only=True):
 class ModifyBody(msgspec.Struct, frozen=True, kw_only=True, forbid_unknown_fields=True):
     """``PATCH /v1/actions/{id}``: a new priority and/or new parameters."""
 
-    priority: Positive | None = None
+    priority: Priority | None = None
     action: Action | None = None
     request_id: str | None = None
 
@@ -43,10 +41,18 @@ class GestureBody(msgspec.Struct, frozen=True, kw_only=True, forbid_unknown_fiel
     request_id: str | None = None
 
 
-class FaultBody(msgspec.Struct, frozen=True, kw_only=True):
-    """Documentation shape of ``POST /v1/sim/faults`` (a proto ``SimFault``)."""
+class PlanQuality(msgspec.Struct, frozen=True, kw_only=True):
+    """``GET /v1/plan/quality``: the live plan's objective (s), mission seconds
+    since an improvement was adopted, its gap to the best plan seen for the
+    state (a fraction); null where not known yet."""
 
-    type: str
-    uav_id: Id | None = None
-    worker_id: Id | None = None
-    position: Point | None = None
+    objective_s: float | None
+    improved_ago_s: float | None
+    gap_to_best: float | None
+
+
+class Health(msgspec.Struct, frozen=True, kw_only=True):
+    """``GET /healthz``: the gateway answers; whether a ground station is up."""
+
+    status: Literal["ok"] = "ok"
+    ground_station: Literal["up", "down"]

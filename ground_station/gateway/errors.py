@@ -30,6 +30,15 @@ STATUS_BY_CODE: dict[str, int] = {
 }
 
 
+class ErrorBody(msgspec.Struct, frozen=True, kw_only=True):
+    """Every error answer: a code of :data:`STATUS_BY_CODE`, a sentence for
+    people and the request field at fault (null: the request as a whole)."""
+
+    error: str
+    message: str
+    field: str | None = None
+
+
 class HttpError(LinecrewError):
     """An error raised by the gateway itself (bad body, unknown gesture...)."""
 

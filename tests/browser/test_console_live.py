@@ -353,3 +353,22 @@ def test_a_worker_who_moves_is_drawn_where_the_tracker_sees_them(run, new_page, 
         back = {"x_m": start.x_m, "y_m": start.y_m, "z_m": start.z_m}
         gateway.call("POST", "/v1/sim/faults", json={**body, "position": back})
     assert not log.errors, log.errors
+
+
+def test_the_api_docs_render_from_the_gateway_alone(run, new_page, artefacts):
+    page, log = new_page()
+    origin = urlsplit(run.url).netloc
+    page.route(  # a control room without internet: nothing but the gateway answers
+        "**/*",
+        lambda route: (
+            route.continue_() if urlsplit(route.request.url).netloc == origin else route.abort()
+        ),
+    )
+    page.goto(f"{run.url}/docs")
+    page.locator(".swagger-ui .info .title").wait_for()
+    assert "linecrew gateway" in page.inner_text(".swagger-ui .info .title")
+    page.locator(".opblock-summary-path[data-path='/v1/actions']").first.wait_for()
+    assert page.locator(".auth-wrapper .authorize").count() == 1  # the bearer scheme
+    assert {urlsplit(r.url).netloc for r in log.requests} == {origin}
+    assert not log.errors, log.errors
+    shoot(page, artefacts, "docs")
