@@ -11,7 +11,6 @@ from __future__ import annotations
 
 import hashlib
 import pathlib
-import secrets
 import time
 
 SIGNING_EPOCH_S = 1420070400  # MAVLink signing timestamps count from 2015-01-01 UTC
@@ -35,14 +34,6 @@ def load_key(path: str | pathlib.Path) -> bytes:
             f">= {MIN_PASSPHRASE} characters"
         )
     return hashlib.sha256(passphrase.encode("utf-8")).digest()
-
-
-def write_key(path: pathlib.Path) -> pathlib.Path:
-    """Write a fresh random passphrase to ``path`` (owner-only) and return it."""
-    path.parent.mkdir(parents=True, exist_ok=True)
-    path.touch(mode=0o600)
-    path.write_text(secrets.token_hex(24) + "\n", encoding="utf-8")
-    return path
 
 
 def key_path(directory: str | pathlib.Path, uav_id: str) -> pathlib.Path:
