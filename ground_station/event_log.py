@@ -34,6 +34,17 @@ class EventLog:
         """Events published but not yet in the store."""
         return len(self._unstored)
 
+    @property
+    def last_seq(self) -> int:
+        """The newest event's ``seq`` (0 before the first)."""
+        return self._seq
+
+    def after(self, after_seq: int, limit: int) -> list[GsEvent]:
+        """At most ``limit`` events with ``seq > after_seq``, oldest first: the
+        stored ones, then those still waiting for the store (all newer)."""
+        waiting = [e for e in self._unstored if e.seq > after_seq]
+        return (self._store.events(after_seq, limit) + waiting)[:limit]
+
     def emit(
         self,
         kind: EventKind,

@@ -151,7 +151,8 @@ class MissionManager:
                 chosen = [plans[uav_id]] if uav_id in plans else [] if uav_id else plans.values()
                 return PlansReply(plans=list(chosen), **self.plan_quality())
             case GetHistory(after_seq=after, limit=limit):
-                return HistoryReply(events=fitting(self.store.events(after, limit)))
+                events = fitting(self.events.after(after, limit))
+                return HistoryReply(events=events, last_seq=self.events.last_seq)
         raise RequestError(f"unsupported request {type(request).__name__}")
 
     def fleet(self) -> FleetReply:
@@ -203,6 +204,11 @@ class MissionManager:
                 stored = as_requested(stored, action)
             if stored != action:
                 raise Conflict("request_id already used for another action", field="request_id")
+            if request.action_id not in (None, existing.action_id):
+                raise Conflict(
+                    f"request_id already used for action {existing.action_id!r}",
+                    field="action_id",
+                )
             return existing
         validate(action, self.scenario.site, self.scenario.fleet)
         if isinstance(action, DeliverAction):

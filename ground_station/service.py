@@ -14,8 +14,11 @@ from __future__ import annotations
 import asyncio
 import logging
 import time
+import uuid
 from collections.abc import Callable
 from typing import Any
+
+import msgspec
 
 from ground_station.config import GsConfig
 from ground_station.event_log import EventLog
@@ -33,6 +36,9 @@ from proto.scenario import Scenario
 from proto.telemetry import AgentStatus, TaskOutcome, Telemetry
 
 TRAFFIC_PERIOD_S = 0.5
+FUTURE_TOLERANCE_S = 60.0
+"""How far ahead of the mission clock a UAV's sample may be stamped (clock skew
+between machines); later stamps are forged or broken: dropped, counted."""
 
 log = logging.getLogger("linecrew.ground_station")
 
@@ -52,6 +58,8 @@ class GroundStation:
         self.clock = clock
         self.keys = KeySpace(scenario.site.id)
         self.identity_mismatches = 0  # samples dropped: their ids disagree with their key
+        self.future_stamps = 0  # samples dropped: stamped too far in the future
+        self.generation = f"gs-{uuid.uuid4().hex[:12]}"  # this run, in every traffic report
         self.store = Store(config.db_path)
         self.monitor = FleetMonitor([u.id for u in scenario.fleet.uavs], config.link_timeout_s)
         self.events = EventLog(self.store, lambda e: bus.publish(self.keys.events(), e), clock)
@@ -125,28 +133,33 @@ class GroundStation:
             except Exception:
                 log.exception("failed to handle a message on %s", key)
 
-    def _bound(self, key: str, uav_id: str) -> bool:
+    def _bound(self, key: str, uav_id: str, stamp_s: float) -> bool:
         """Whether a sample about ``uav_id`` came on that UAV's own key (under
-        the secured profile, only its certificate may publish there); one
-        that did not is dropped and counted."""
-        if self.keys.owns(key, "uav", uav_id):
-            return self.monitor.known(uav_id)
-        self.identity_mismatches += 1
-        log.warning("dropped a sample about %s that came on %s", uav_id, key)
-        return False
+        the secured profile, only its certificate may publish there) and is
+        not stamped beyond :data:`FUTURE_TOLERANCE_S` of mission time ahead;
+        one that fails either is dropped and counted."""
+        if not self.keys.owns(key, "uav", uav_id):
+            self.identity_mismatches += 1
+            log.warning("dropped a sample about %s that came on %s", uav_id, key)
+            return False
+        if stamp_s > self.clock() + FUTURE_TOLERANCE_S:
+            self.future_stamps += 1
+            log.warning("dropped a sample on %s stamped %.0f s ahead", key, stamp_s - self.clock())
+            return False
+        return self.monitor.known(uav_id)
 
     def _on_telemetry(self, key: str, telemetry: Telemetry) -> None:
-        if self._bound(key, telemetry.uav_id):
+        if self._bound(key, telemetry.uav_id, telemetry.stamp_s):
             self.monitor.on_telemetry(telemetry, time.monotonic())
             self.manager.reports.on_telemetry(telemetry)
 
     def _on_status(self, key: str, status: AgentStatus) -> None:
-        if self._bound(key, status.uav_id):
+        if self._bound(key, status.uav_id, status.stamp_s):
             self.monitor.on_status(status, time.monotonic())
             self.manager.reports.on_status(status)
 
     def _on_outcome(self, key: str, outcome: TaskOutcome) -> None:
-        if self._bound(key, outcome.uav_id):
+        if self._bound(key, outcome.uav_id, outcome.stamp_s):
             self.manager.reports.on_outcome(outcome)
 
     def _on_token(self, key: str, alive: bool) -> None:
@@ -168,7 +181,10 @@ class GroundStation:
         """Tell the agents where every UAV is, ``TRAFFIC_PERIOD_S`` apart."""
         while True:
             try:
-                self.bus.publish(self.keys.traffic(), self.monitor.traffic(time.monotonic()))
+                report = self.monitor.traffic(time.monotonic())
+                epoch = self.store.counter("epoch")
+                announced = msgspec.structs.replace(report, generation=self.generation, epoch=epoch)
+                self.bus.publish(self.keys.traffic(), announced)
             except Exception:
                 log.exception("traffic report not sent")
             await asyncio.sleep(TRAFFIC_PERIOD_S)
@@ -221,6 +237,7 @@ class GroundStation:
             "epoch": self.store.counter("epoch"),
             "bus_malformed": sum(self.bus.stats.malformed.values()),
             "bus_identity_mismatch": self.identity_mismatches,
+            "bus_future_stamps": self.future_stamps,
             "store_failing": float(self.store.failing is not None),
             "events_unstored": self.events.unstored,
         }

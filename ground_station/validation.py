@@ -111,30 +111,15 @@ def _check_position(position: Any, field: str, site: Site) -> None:
         )
     if position.z_m > MAX_ALTITUDE_M:
         raise InvalidAction(f"z above {MAX_ALTITUDE_M:.0f} m", field=f"{field}.z_m")
-    box = _area(site)
+    box = site.area()
     if box is not None:
-        (x0, y0), (x1, y1) = box
-        if not (x0 <= position.x_m <= x1 and y0 <= position.y_m <= y1):
+        if not site.in_area(position):
+            (x0, y0), (x1, y1) = box
             raise InvalidAction(
                 f"outside the site's area (x {x0:g}..{x1:g}, y {y0:g}..{y1:g} m)", field=field
             )
     elif max(abs(position.x_m), abs(position.y_m)) > MAX_RANGE_M:
         raise InvalidAction(f"more than {MAX_RANGE_M:.0f} m from the site", field=field)
-
-
-def _area(site: Site) -> tuple[tuple[float, float], tuple[float, float]] | None:
-    """The box around the site's features, widened by ``area_margin_m``."""
-    points = [
-        *(t.position for t in site.towers),
-        *(s.position for s in site.stations),
-        *(t.position for t in site.tool_stations),
-        *(w.position for w in site.workers),
-    ]
-    if not points:
-        return None
-    m = site.safety.area_margin_m
-    xs, ys = [p.x_m for p in points], [p.y_m for p in points]
-    return (min(xs) - m, min(ys) - m), (max(xs) + m, max(ys) + m)
 
 
 def coverable_s(site: Site, fleet: Fleet, k: int) -> float:

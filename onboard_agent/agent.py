@@ -87,9 +87,16 @@ class Agent:
     def offer_plan(self, plan: Plan) -> PlanVerdict:
         """A plan from the ground station (epoch-fenced)."""
         verdict = self.mission.offer(plan)
-        if verdict is PlanVerdict.ACCEPTED and self.ctx.emergency:
-            self.emergency.check()
+        self._adopted(verdict)
         return verdict
+
+    def announce(self, generation: str | None, epoch: int) -> None:
+        """The ground station's generation and newest epoch (its traffic report)."""
+        self._adopted(self.mission.announce(generation, epoch))
+
+    def _adopted(self, verdict: PlanVerdict | None) -> None:
+        if verdict is PlanVerdict.ACCEPTED and self.ctx.emergency:
+            self.emergency.check()  # an emergency re-reads the queue it now has
 
     def human_pose(self, pose: HumanPose) -> None:
         self.ctx.surroundings.update_pose(pose)

@@ -80,6 +80,7 @@ class Comms:
         async with self.bus.subscribe_async(self.keys.traffic(), TrafficReport) as sub:
             async for _key, report in sub:
                 self.agent.ctx.traffic.update(report, self.agent.ctx.link_clock())
+                self.agent.announce(report.generation, report.epoch)
 
     async def _ground_stations(self) -> None:
         key = self.keys.all_alive(Role.GROUND_STATION)

@@ -23,12 +23,20 @@ from proto.telemetry import OutcomeResult, TaskOutcome
 log = logging.getLogger(__name__)
 
 
+EPOCH_LEAD = 100
+"""How far a plan's epoch may run ahead of the ground station's last
+announced one (``Traffic.epoch``) and still be adopted at once: replans in
+the half second between announcements. A farther one waits for an
+announcement that covers it (a forged epoch never gets one)."""
+
+
 class PlanVerdict(enum.StrEnum):
     """What :meth:`Mission.offer` did with a plan."""
 
     ACCEPTED = "accepted"
     STALE = "stale"
     REJECTED = "rejected"
+    UNANNOUNCED = "unannounced"  # too far ahead of the announced epoch: held
 
 
 class Mission:
@@ -39,6 +47,9 @@ class Mission:
         self.site = site
         self.wall = wall
         self.epoch = 0
+        self.generation: str | None = None  # the ground station's run, as announced
+        self.announced = 0  # the newest epoch that ground station has announced
+        self._unannounced: Plan | None = None  # ahead of every announcement: held
         self.tasks: collections.deque[Task] = collections.deque()
         self.outbox: list[TaskOutcome] = []
         self._sent: collections.deque[TaskOutcome] = collections.deque(maxlen=16)
@@ -62,6 +73,15 @@ class Mission:
         if plan.epoch <= self.epoch:
             log.info("ignored plan epoch %d (holding %d)", plan.epoch, self.epoch)
             return PlanVerdict.STALE
+        if plan.epoch > self.announced + EPOCH_LEAD:
+            log.warning(
+                "held plan epoch %d: the ground station announced %d",
+                plan.epoch,
+                self.announced,
+                extra={"uav_id": self.uav_id},
+            )
+            self._unannounced = plan
+            return PlanVerdict.UNANNOUNCED
         kept = {t.task_id for t in plan.tasks}
         head = self.head
         if head is not None and head.task_id in self._started and head.task_id not in kept:
@@ -78,6 +98,20 @@ class Mission:
                 self._report(task, OutcomeResult.FAILED, reason, code="invalid_task")
         log.info("plan epoch %d: %d tasks", plan.epoch, len(self.tasks))
         return PlanVerdict.ACCEPTED
+
+    def announce(self, generation: str | None, epoch: int) -> PlanVerdict | None:
+        """The ground station ``generation`` says it has issued epochs up to
+        ``epoch`` (a new generation starts over); a held plan it now covers
+        is offered again (its verdict; None if none was held)."""
+        if generation != self.generation:
+            self.generation, self.announced = generation, epoch
+        else:
+            self.announced = max(self.announced, epoch)
+        held = self._unannounced
+        if held is None or held.epoch > self.announced + EPOCH_LEAD:
+            return None
+        self._unannounced = None
+        return self.offer(held)
 
     @property
     def head(self) -> Task | None:

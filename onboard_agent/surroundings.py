@@ -4,10 +4,12 @@ the workers are (their last tracked pose, else where the site puts them)."""
 from __future__ import annotations
 
 import math
+import time
+from collections.abc import Callable
 
 from proto.geo import Point
 from proto.site import ChargingStation, Site, ToolStation
-from proto.telemetry import HumanPose
+from proto.telemetry import POSE_FUTURE_S, HumanPose
 
 
 def horizontal_distance(a: Point, b: Point) -> float:
@@ -18,12 +20,18 @@ def horizontal_distance(a: Point, b: Point) -> float:
 class Surroundings:
     """The site plus the latest human poses."""
 
-    def __init__(self, site: Site) -> None:
+    def __init__(self, site: Site, clock: Callable[[], float] = time.time) -> None:
         self.site = site
+        self.clock = clock  # real time, as poses are stamped
         self._poses: dict[str, HumanPose] = {}
+        self.refused = 0  # poses stamped beyond POSE_FUTURE_S ahead
 
     def update_pose(self, pose: HumanPose) -> None:
-        """Keep the newest pose of each worker (older stamps are ignored)."""
+        """Keep the newest pose of each worker (older stamps are ignored, and
+        stamps from the future beyond :data:`POSE_FUTURE_S` are refused)."""
+        if pose.stamp_s > self.clock() + POSE_FUTURE_S:
+            self.refused += 1
+            return
         known = self._poses.get(pose.worker_id)
         if known is None or pose.stamp_s >= known.stamp_s:
             self._poses[pose.worker_id] = pose

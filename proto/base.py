@@ -12,9 +12,21 @@ SCHEMA_VERSION = 1
 MIN_SCHEMA_VERSION = 1
 """Oldest schema version this code still decodes."""
 
+MAX_MAGNITUDE = 1e15
+"""Every float on the wire is finite and within this magnitude (NaN and
+infinities fail validation, so a sample holding one is dropped and counted)."""
+Finite = Annotated[float, msgspec.Meta(ge=-MAX_MAGNITUDE, le=MAX_MAGNITUDE)]
 Fraction = Annotated[float, msgspec.Meta(ge=0.0, le=1.0, description="fraction 0..1")]
-NonNegative = Annotated[float, msgspec.Meta(ge=0.0)]
-Positive = Annotated[float, msgspec.Meta(gt=0.0)]
+NonNegative = Annotated[float, msgspec.Meta(ge=0.0, le=MAX_MAGNITUDE)]
+Positive = Annotated[float, msgspec.Meta(gt=0.0, le=MAX_MAGNITUDE)]
+MAX_TEXT = 4096
+"""Longest free text (reasons, details, modes) on the wire, in characters."""
+Text = Annotated[str, msgspec.Meta(max_length=MAX_TEXT)]
+MAX_REQUEST_ID = 128
+RequestId = Annotated[
+    str,
+    msgspec.Meta(min_length=1, max_length=MAX_REQUEST_ID, description="a client's idempotency key"),
+]
 MAX_INT = 2**53
 """Integers on the wire stay below this: exact in every JSON reader's doubles."""
 Count = Annotated[int, msgspec.Meta(ge=0, le=MAX_INT)]

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import enum
 
-from proto.base import Count, Id, Message
+from proto.base import Count, Finite, Id, Message, Text
 
 
 class EventKind(enum.StrEnum):
@@ -30,9 +30,9 @@ class GsEvent(Message, frozen=True, kw_only=True):
     """One event. ``seq`` increases by one per event of a ground station."""
 
     seq: Count
-    stamp_s: float
+    stamp_s: Finite
     kind: EventKind
     action_id: Id | None = None
     uav_id: Id | None = None
     epoch: Count | None = None
-    detail: str = ""
+    detail: Text = ""

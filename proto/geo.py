@@ -11,15 +11,15 @@ import math
 
 import pymap3d
 
-from proto.base import Record
+from proto.base import Finite, Record
 
 
 class Point(Record, frozen=True, kw_only=True):
     """A point in the site's local frame: x east, y north, z up, metres."""
 
-    x_m: float
-    y_m: float
-    z_m: float = 0.0
+    x_m: Finite
+    y_m: Finite
+    z_m: Finite = 0.0
 
     def distance_to(self, other: Point) -> float:
         """Euclidean distance in metres."""
@@ -29,17 +29,17 @@ class Point(Record, frozen=True, kw_only=True):
 class Vector(Record, frozen=True, kw_only=True):
     """A velocity in the local frame, metres per second (east, north, up)."""
 
-    east_mps: float = 0.0
-    north_mps: float = 0.0
-    up_mps: float = 0.0
+    east_mps: Finite = 0.0
+    north_mps: Finite = 0.0
+    up_mps: Finite = 0.0
 
 
 class GeoPoint(Record, frozen=True, kw_only=True):
     """A WGS84 position: degrees, and metres above the ellipsoid."""
 
-    lat_deg: float = 0.0
-    lon_deg: float = 0.0
-    alt_m: float = 0.0
+    lat_deg: Finite = 0.0
+    lon_deg: Finite = 0.0
+    alt_m: Finite = 0.0
 
 
 class LocalFrame:

@@ -6,6 +6,7 @@ import enum
 
 from proto.base import (
     Bearing,
+    Finite,
     Fraction,
     Id,
     NonNegative,
@@ -13,6 +14,8 @@ from proto.base import (
     PositiveCount,
     Priority,
     Record,
+    RequestId,
+    Text,
 )
 from proto.geo import Point
 
@@ -97,10 +100,10 @@ class ActionRecord(Record, frozen=True, kw_only=True):
     action: Action
     state: ActionState
     progress: Fraction = 0.0
-    created_s: float = 0.0
-    updated_s: float = 0.0
-    reason: str = ""
-    request_id: str | None = None
+    created_s: Finite = 0.0
+    updated_s: Finite = 0.0
+    reason: Text = ""
+    request_id: RequestId | None = None
     waypoints_done: list[int] = []
     monitored_s: NonNegative = 0.0
     segments: dict[str, int] = {}

@@ -8,7 +8,17 @@ seconds, ``energy_after_wh``) so agents can judge "battery enough".
 
 from __future__ import annotations
 
-from proto.base import Count, Fraction, Id, Message, NonNegative, Positive, PositiveCount, Record
+from proto.base import (
+    Count,
+    Finite,
+    Fraction,
+    Id,
+    Message,
+    NonNegative,
+    Positive,
+    PositiveCount,
+    Record,
+)
 from proto.geo import Point
 
 
@@ -17,9 +27,9 @@ class TaskBase(Record, frozen=True, kw_only=True):
 
     task_id: Id
     action_id: Id | None = None
-    start_s: float = 0.0
-    end_s: float = 0.0
-    energy_after_wh: float = 0.0
+    start_s: Finite = 0.0
+    end_s: Finite = 0.0
+    energy_after_wh: Finite = 0.0
 
 
 class Waypoint(Record, frozen=True, kw_only=True):
@@ -49,7 +59,7 @@ class MonitorTask(TaskBase, frozen=True, kw_only=True, tag="monitor"):
     standoff_m: Positive
     duration_s: Positive
     height_m: NonNegative = 3.0
-    bearing_deg: float = 0.0
+    bearing_deg: Finite = 0.0
 
 
 class PickTask(TaskBase, frozen=True, kw_only=True, tag="pick"):
@@ -80,7 +90,7 @@ class RechargeTask(TaskBase, frozen=True, kw_only=True, tag="recharge"):
 class WaitTask(TaskBase, frozen=True, kw_only=True, tag="wait"):
     """Hold (on the pad if landed) until ``until_s`` (UNIX seconds)."""
 
-    until_s: float
+    until_s: Finite
 
 
 class GoHomeTask(TaskBase, frozen=True, kw_only=True, tag="home"):
@@ -111,5 +121,5 @@ class Plan(Message, frozen=True, kw_only=True):
 
     uav_id: Id
     epoch: Count
-    issued_s: float = 0.0
+    issued_s: Finite = 0.0
     tasks: list[Task] = []

@@ -12,7 +12,7 @@ import enum
 import typing
 from typing import ClassVar
 
-from proto.base import Count, Id, Message, PositiveCount, Priority, Record
+from proto.base import Count, Finite, Id, Message, PositiveCount, Priority, Record, RequestId, Text
 from proto.events import GsEvent
 from proto.mission import Action, ActionRecord, ActionState
 from proto.plan import Plan
@@ -29,7 +29,7 @@ class SubmitAction(RequestBase, frozen=True, kw_only=True, tag="submit"):
     """Add an action. Replies :class:`ActionReply`."""
 
     op = "submit"
-    request_id: str
+    request_id: RequestId
     action: Action
     action_id: Id | None = None  # a client-chosen id (else the ground station assigns one)
 
@@ -39,7 +39,7 @@ class ModifyAction(RequestBase, frozen=True, kw_only=True, tag="modify"):
     :class:`ActionReply`."""
 
     op = "modify"
-    request_id: str
+    request_id: RequestId
     action_id: Id
     priority: Priority | None = None
     action: Action | None = None
@@ -49,7 +49,7 @@ class CancelAction(RequestBase, frozen=True, kw_only=True, tag="cancel"):
     """Cancel an action. Replies :class:`ActionReply`."""
 
     op = "cancel"
-    request_id: str
+    request_id: RequestId
     action_id: Id
 
 
@@ -157,7 +157,7 @@ class UavState(Record, frozen=True, kw_only=True):
     state: UavOpState
     telemetry: Telemetry | None = None
     status: AgentStatus | None = None
-    silent_s: float | None = None
+    silent_s: Finite | None = None
     """Seconds the UAV has been silent, while it is silent but within the
     link timeout (not yet lost); None when heard normally or already lost.
     Its tasks' fate is unknown meanwhile, not failed."""
@@ -191,23 +191,25 @@ class PlansReply(Message, frozen=True, kw_only=True, tag="plans"):
     state (a fraction); None where not known yet."""
 
     plans: list[Plan]
-    objective_s: float | None = None
-    improved_ago_s: float | None = None
-    gap_to_best: float | None = None
+    objective_s: Finite | None = None
+    improved_ago_s: Finite | None = None
+    gap_to_best: Finite | None = None
 
 
 class HistoryReply(Message, frozen=True, kw_only=True, tag="history"):
-    """Events, oldest first."""
+    """Events, oldest first, and the newest ``seq`` the ground station has
+    numbered (the end of the log, whatever ``after_seq`` asked)."""
 
     events: list[GsEvent]
+    last_seq: Count = 0
 
 
 class ErrorReply(Message, frozen=True, kw_only=True, tag="error"):
     """A typed failure: stable ``code``, human ``message``, offending ``field``."""
 
-    code: str
-    message: str
-    field: str | None = None
+    code: Text
+    message: Text
+    field: Text | None = None
 
 
 class MetricsReply(Message, frozen=True, kw_only=True, tag="metrics"):

@@ -4,7 +4,7 @@ agents and ``linecrew up`` / ``demo`` all load (YAML or JSON)."""
 
 from __future__ import annotations
 
-from proto.base import Id, Message, NonNegative, Record
+from proto.base import Id, Message, NonNegative, Record, Text
 from proto.fleet import Fleet
 from proto.mission import Action
 from proto.site import Site
@@ -22,7 +22,7 @@ class Scenario(Message, frozen=True, kw_only=True):
     """Everything needed to run a mission, simulated or real."""
 
     name: Id
-    description: str = ""
+    description: Text = ""
     site: Site
     fleet: Fleet
     actions: list[ScriptedAction] = []

@@ -3,7 +3,7 @@ simulator's ground truth (queries on ``sim/state``)."""
 
 from __future__ import annotations
 
-from proto.base import Fraction, Id, Message, Positive, Record
+from proto.base import Finite, Fraction, Id, Message, Positive, Record, Text
 from proto.geo import Point
 
 
@@ -78,8 +78,8 @@ class FaultApplied(Message, frozen=True, kw_only=True):
     did, at which simulated time."""
 
     target: Id
-    detail: str
-    sim_time_s: float
+    detail: Text
+    sim_time_s: Finite
 
 
 class GetSimState(Message, frozen=True, kw_only=True, tag="sim_state"):
@@ -89,10 +89,10 @@ class GetSimState(Message, frozen=True, kw_only=True, tag="sim_state"):
 class DeliveryRecord(Record, frozen=True, kw_only=True):
     """A tool released within reach of a worker (the simulator's truth)."""
 
-    tool: str
+    tool: Text
     uav_id: Id
     worker_id: Id
-    sim_time_s: float
+    sim_time_s: Finite
 
 
 class SafetyViolation(Record, frozen=True, kw_only=True):
@@ -105,11 +105,11 @@ class SafetyViolation(Record, frozen=True, kw_only=True):
     closer than ``separation_m``). One record each time a condition begins.
     """
 
-    kind: str
+    kind: Text
     uav_id: Id
-    sim_time_s: float
+    sim_time_s: Finite
     position: Point
-    detail: str = ""
+    detail: Text = ""
 
 
 class WatchRecord(Record, frozen=True, kw_only=True):
@@ -118,7 +118,7 @@ class WatchRecord(Record, frozen=True, kw_only=True):
 
     worker_id: Id
     uav_id: Id
-    seconds: float
+    seconds: Finite
 
 
 class VehicleTruth(Record, frozen=True, kw_only=True):
@@ -127,9 +127,9 @@ class VehicleTruth(Record, frozen=True, kw_only=True):
     uav_id: Id
     position: Point
     battery_fraction: Fraction
-    state: str
+    state: Text
     armed: bool
-    tool: str | None = None
+    tool: Text | None = None
     docked_at: Id | None = None
 
 
@@ -137,8 +137,8 @@ class SimState(Message, frozen=True, kw_only=True):
     """The simulator's ground truth: time, vehicles, deliveries, safety
     violations and watched seconds."""
 
-    sim_time_s: float
-    speedup: float
+    sim_time_s: Finite
+    speedup: Finite
     vehicles: list[VehicleTruth] = []
     deliveries: list[DeliveryRecord] = []
     violations: list[SafetyViolation] = []

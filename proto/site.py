@@ -5,7 +5,7 @@ stations, workers. Positions are local ENU metres (see :mod:`proto.geo`).
 
 from __future__ import annotations
 
-from proto.base import Count, Id, Message, NonNegative, Positive, PositiveCount, Record
+from proto.base import Count, Finite, Id, Message, NonNegative, Positive, PositiveCount, Record
 from proto.geo import GeoPoint, Point
 
 
@@ -97,7 +97,7 @@ class Safety(Record, frozen=True, kw_only=True):
     ``area_margin_m`` outside the box around the site's features are refused.
     """
 
-    ground_z_m: float = 0.0
+    ground_z_m: Finite = 0.0
     min_altitude_m: NonNegative = 2.0
     monitor_height_m: NonNegative = 3.0
     people_clearance_m: NonNegative = 1.5
@@ -128,6 +128,29 @@ class Site(Message, frozen=True, kw_only=True):
     def worker(self, worker_id: str) -> Worker | None:
         """The worker with this id, if any."""
         return next((w for w in self.workers if w.id == worker_id), None)
+
+    def area(self) -> tuple[tuple[float, float], tuple[float, float]] | None:
+        """The box ``((x0, y0), (x1, y1))`` around the site's features, widened
+        by ``safety.area_margin_m``; None for a site with no feature."""
+        points = [
+            *(t.position for t in self.towers),
+            *(s.position for s in self.stations),
+            *(t.position for t in self.tool_stations),
+            *(w.position for w in self.workers),
+        ]
+        if not points:
+            return None
+        m = self.safety.area_margin_m
+        xs, ys = [p.x_m for p in points], [p.y_m for p in points]
+        return (min(xs) - m, min(ys) - m), (max(xs) + m, max(ys) + m)
+
+    def in_area(self, point: Point) -> bool:
+        """Whether ``point`` lies inside :meth:`area` (a site with none has no inside)."""
+        box = self.area()
+        if box is None:
+            return False
+        (x0, y0), (x1, y1) = box
+        return x0 <= point.x_m <= x1 and y0 <= point.y_m <= y1
 
 
 __all__ = [

@@ -15,7 +15,7 @@ controller's time limit.
 
 from __future__ import annotations
 
-from proto.base import Count, Id, Message
+from proto.base import Count, Finite, Id, Message
 from proto.fleet import Fleet
 from proto.geo import Point
 from proto.site import ChargingStation
@@ -47,7 +47,7 @@ class SpotClaim(Message, frozen=True, kw_only=True):
     uav_id: Id
     station_id: Id | None = None
     spot: Count = 0
-    stamp_s: float = 0.0
+    stamp_s: Finite = 0.0
 
 
 class StationSpots(Message, frozen=True, kw_only=True):
@@ -55,6 +55,6 @@ class StationSpots(Message, frozen=True, kw_only=True):
     (``landed``) and who may land on each (``granted``), by spot index."""
 
     station_id: Id
-    stamp_s: float = 0.0
+    stamp_s: Finite = 0.0
     landed: list[Id | None] = []
     granted: list[Id | None] = []

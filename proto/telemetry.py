@@ -5,8 +5,11 @@ task outcomes and human poses. Times are UNIX seconds (``stamp_s``).
 from __future__ import annotations
 
 import enum
+from typing import Annotated
 
-from proto.base import Count, Fraction, Id, Message, NonNegative, Record
+import msgspec
+
+from proto.base import Count, Finite, Fraction, Id, Message, NonNegative, Record, Text
 from proto.geo import GeoPoint, Point, Vector
 
 
@@ -25,16 +28,16 @@ class Telemetry(Message, frozen=True, kw_only=True):
     """Published by each agent at about 5 Hz on ``uav/{id}/telemetry``."""
 
     uav_id: Id
-    stamp_s: float
+    stamp_s: Finite
     position: Point
     geo: GeoPoint
     velocity: Vector = Vector()
-    heading_deg: float = 0.0
+    heading_deg: Finite = 0.0
     battery_wh: NonNegative
     battery_fraction: Fraction
     flight_state: FlightState = FlightState.UNKNOWN
     armed: bool = False
-    mode: str = ""
+    mode: Text = ""
     tool: Id | None = None
 
 
@@ -50,9 +53,16 @@ class TrafficEntry(Record, frozen=True, kw_only=True):
 
 class Traffic(Message, frozen=True, kw_only=True):
     """Where the fleet's UAVs are, from the ground station twice a second
-    on ``gs/traffic``: agents keep clear of points another UAV hovers at."""
+    on ``gs/traffic``: agents keep clear of points another UAV hovers at.
+
+    It also announces the ground station: ``generation`` (one id per
+    ground-station run) and ``epoch``, the newest plan epoch it has issued.
+    An agent adopts a plan whose epoch runs far ahead of what was announced
+    only once an announcement covers it."""
 
     uavs: list[TrafficEntry] = []
+    generation: Id | None = None
+    epoch: Count = 0
 
 
 class AgentState(enum.StrEnum):
@@ -70,14 +80,14 @@ class AgentStatus(Message, frozen=True, kw_only=True):
     """Published by each agent at 1 Hz and on change on ``uav/{id}/status``."""
 
     uav_id: Id
-    stamp_s: float
+    stamp_s: Finite
     state: AgentState
     epoch: Count = 0
     task_id: Id | None = None
     progress: Fraction = 0.0
-    active_path: list[str] = []
+    active_path: Annotated[list[Text], msgspec.Meta(max_length=64)] = []
     queue_length: Count = 0
-    reason: str = ""
+    reason: Text = ""
     ready: bool = True  # False while the autopilot cannot arm (``reason`` says why)
     holding_for: Id | None = None
     """Another UAV at the point this one flies to next: it holds where it is
@@ -114,20 +124,27 @@ class TaskOutcome(Message, frozen=True, kw_only=True):
     action_id: Id | None = None
     epoch: Count
     result: OutcomeResult
-    reason: str = ""
+    reason: Text = ""
     progress: Fraction = 1.0
     waypoints_done: list[int] = []
-    stamp_s: float = 0.0
+    stamp_s: Finite = 0.0
     flown_s: NonNegative = 0.0
     tool: Id | None = None
     retryable: bool = False
-    reason_code: str = ""
+    reason_code: Text = ""
+
+
+POSE_FUTURE_S = 5.0
+"""A worker pose stamped more than this ahead of the reader's real-time clock
+is refused (a forged one would otherwise outrank every real pose)."""
 
 
 class HumanPose(Message, frozen=True, kw_only=True):
-    """A worker's position from the human tracker, on ``human/{id}/pose``."""
+    """A worker's position from the human tracker, on ``human/{id}/pose``.
+    ``stamp_s`` is real UNIX time (the tracker is a device in the world, not
+    on the mission clock)."""
 
     worker_id: Id
-    stamp_s: float
+    stamp_s: Finite
     position: Point
     geo: GeoPoint

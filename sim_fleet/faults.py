@@ -17,6 +17,7 @@ from proto.sim import (
     MoveWorker,
     SimFault,
 )
+from proto.site import Site
 from sim_fleet.world import World
 
 log = logging.getLogger(__name__)
@@ -28,7 +29,14 @@ class UnknownTarget(RequestError):
     code = "not_found"
 
 
-def apply_fault(world: World, fault: SimFault) -> FaultApplied:
+class OutsideSite(RequestError):
+    """A worker moved outside the site's area (``Site.area``): nobody works
+    there, and no UAV may fly there to follow them."""
+
+    code = "invalid_request"
+
+
+def apply_fault(world: World, fault: SimFault, site: Site) -> FaultApplied:
     """Apply ``fault`` now (durations are simulated seconds); log and acknowledge it."""
     if isinstance(fault, MoveWorker):
         if fault.worker_id not in world.workers:
@@ -36,6 +44,10 @@ def apply_fault(world: World, fault: SimFault) -> FaultApplied:
                 _unknown("worker", fault.worker_id, world.workers), field="worker_id"
             )
         p = fault.position
+        if not site.in_area(p):
+            raise OutsideSite(
+                f"({p.x_m:g}, {p.y_m:g}) is outside the site's area", field="position"
+            )
         world.move_worker(fault.worker_id, (p.x_m, p.y_m, p.z_m))
         return _applied(world, fault.worker_id, f"moved to ({p.x_m:g}, {p.y_m:g}, {p.z_m:g})")
     vehicle = world.vehicles.get(fault.uav_id)

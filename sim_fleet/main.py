@@ -44,7 +44,7 @@ async def serve(
         return 1
     keys = KeySpace(scenario.site.id)
     world, speedup = fleet.world, fleet.config.speedup
-    bus.serve(keys.sim("fault"), SimFault, lambda fault: apply_fault(world, fault))
+    bus.serve(keys.sim("fault"), SimFault, lambda fault: apply_fault(world, fault, scenario.site))
     bus.serve(keys.sim("state"), GetSimState, lambda _request: sim_state(world, speedup))
     bus.declare_token(keys.alive(Role.SIM, sim_id))
     log.info(

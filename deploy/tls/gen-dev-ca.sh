@@ -8,6 +8,8 @@
 # OUT_DIR receives:
 #   ca.pem, ca.key                  the dev CA (ca.key never leaves this machine)
 #   router.pem, router.key          server cert, SAN localhost, 127.0.0.1, ::1, router
+#   https.pem, https.key            the gateway's HTTPS server cert, SAN localhost,
+#                                   127.0.0.1, ::1 (HTTPS_SANS="DNS:ops.example" adds)
 #   <identity>.pem, <identity>.key  client certs, CN = identity:
 #                                   gs, gateway, sim, operator, uav-1 .. uav-N
 #   zenoh/router.json5, zenoh/client-<identity>.json5
@@ -88,6 +90,9 @@ SANS="DNS:localhost,DNS:router,IP:127.0.0.1,IP:::1${ROUTER_SANS:+,$ROUTER_SANS}"
 issue router "$LEAF
 extendedKeyUsage=serverAuth
 subjectAltName=$SANS"
+issue https "$LEAF
+extendedKeyUsage=serverAuth
+subjectAltName=DNS:localhost,IP:127.0.0.1,IP:::1${HTTPS_SANS:+,$HTTPS_SANS}"
 
 client() {
     issue "$1" "$LEAF

@@ -38,7 +38,7 @@ from ground_station.gateway.metrics import GatewayCounters, prometheus_text
 from ground_station.gateway.rpc import GsClient, to_json
 from ground_station.gateway.settings import GatewaySettings
 from ground_station.gateway.workers import WorkerPoses
-from proto.base import ID_PATTERN
+from proto.base import ID_PATTERN, MAX_INT, MAX_REQUEST_ID
 from proto.errors import LinecrewError, RequestTimeout
 from proto.mission import Action, ActionState
 from proto.rpc import (
@@ -67,7 +67,6 @@ its assets (``/console/...``) are public too, see :func:`console.is_public`;
 
 
 MAX_PAGE = 1000  # actions per page
-MAX_SEQ = 2**63 - 1  # event sequence numbers are SQLite integers
 ACTION_ID = Path(pattern=ID_PATTERN, description="an action id, e.g. act-00001")
 UAV_ID = Path(pattern=ID_PATTERN, description="a UAV id, e.g. uav-1")
 
@@ -151,6 +150,12 @@ def create_app(
         action = decode_body(raw, Action)
         envelope = decode_body(raw, SubmitEnvelope)
         request_id = envelope.request_id or request.headers.get("idempotency-key")
+        if request_id is not None and not 0 < len(request_id) <= MAX_REQUEST_ID:
+            raise HttpError(
+                "invalid_request",
+                f"a request id has 1 to {MAX_REQUEST_ID} characters",
+                field="Idempotency-Key",
+            )
         return await submit(action, request_id, envelope.action_id)
 
     @app.get("/v1/actions", summary="List actions, optionally by state, whole or by page")
@@ -257,9 +262,9 @@ def create_app(
     @app.get("/v1/events", summary="Ground-station events as Server-Sent Events")
     async def events(
         request: Request,
-        after_seq: int | None = Query(None, ge=0, le=MAX_SEQ, description="replay after this seq"),
+        after_seq: int | None = Query(None, ge=0, le=MAX_INT, description="replay after this seq"),
     ) -> StreamingResponse:
-        history = None if after_seq is None else await first_history(client, after_seq)
+        history = await first_history(client, after_seq)
         return StreamingResponse(
             event_stream(client, request, after_seq, history), media_type="text/event-stream"
         )

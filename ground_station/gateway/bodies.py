@@ -3,11 +3,11 @@ and the replies it builds itself."""
 
 from __future__ import annotations
 
-from typing import Annotated, Literal
+from typing import Literal
 
 import msgspec
 
-from proto.base import Id, Priority
+from proto.base import Id, Priority, RequestId
 from proto.mission import Action
 from proto.rpc import Command
 
@@ -15,7 +15,7 @@ from proto.rpc import Command
 class SubmitEnvelope(msgspec.Struct, frozen=True, kw_only=True):
     """Optional fields beside the action in ``POST /v1/actions``."""
 
-    request_id: Annotated[str, msgspec.Meta(min_length=1, max_length=128)] | None = None
+    request_id: RequestId | None = None
     action_id: Id | None = None
 
 
@@ -24,7 +24,7 @@ class ModifyBody(msgspec.Struct, frozen=True, kw_only=True, forbid_unknown_field
 
     priority: Priority | None = None
     action: Action | None = None
-    request_id: str | None = None
+    request_id: RequestId | None = None
 
 
 class ControlBody(msgspec.Struct, frozen=True, kw_only=True, forbid_unknown_fields=True):
@@ -38,7 +38,7 @@ class GestureBody(msgspec.Struct, frozen=True, kw_only=True, forbid_unknown_fiel
 
     gesture: str
     target: Id
-    request_id: str | None = None
+    request_id: RequestId | None = None
 
 
 class PlanQuality(msgspec.Struct, frozen=True, kw_only=True):

@@ -23,6 +23,7 @@ STATUS_BY_CODE: dict[str, int] = {
     "conflict": 409,
     "invalid_transition": 409,
     "request_timeout": 503,
+    "encode_error": 503,  # the ground station's answer cannot go on the bus (too large)
     "unavailable": 503,
     "store_unavailable": 503,
     "unauthorized": 401,

@@ -11,7 +11,12 @@ import uvicorn
 from ground_station.gateway.app import create_app
 from ground_station.gateway.gestures import Vocabulary
 from ground_station.gateway.rpc import GsClient
-from ground_station.gateway.settings import GatewaySettings, resolve_token
+from ground_station.gateway.settings import (
+    DevTokenRefused,
+    GatewaySettings,
+    check_token,
+    resolve_token,
+)
 from ground_station.gateway.workers import WorkerPoses
 from linecrew.bus import Bus
 from linecrew.process import common_parser, start
@@ -33,20 +38,25 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--scenario", default="paper", help="site for gesture targets")
     parser.add_argument("--gestures", help="a YAML gesture vocabulary")
     parser.add_argument("--rpc-timeout", type=float, default=2.0, help="seconds before 503")
+    parser.add_argument("--tls-cert", help="serve HTTPS with this certificate (PEM)")
+    parser.add_argument("--tls-key", help="the key of --tls-cert (PEM)")
     args = parser.parse_args(argv)
+    if bool(args.tls_cert) != bool(args.tls_key):
+        parser.error("--tls-cert and --tls-key go together")
     bus_config = start(args, "gateway")
     try:
+        token = check_token(resolve_token(args.token, args.token_file))
         scenario = load(args.scenario, site=args.site)
         vocabulary = Vocabulary.load(args.gestures)
         bus = Bus.open(bus_config)
-    except (ScenarioError, Unavailable, OSError) as exc:
+    except (DevTokenRefused, ScenarioError, Unavailable, OSError) as exc:
         log.error("gateway cannot start: %s", exc)
         return 1
     settings = GatewaySettings(
         host=args.host,
         port=args.port,
         site=scenario.site.id,
-        token=resolve_token(args.token, args.token_file),
+        token=token,
         rpc_timeout_s=args.rpc_timeout,
         gestures=args.gestures,
     )
@@ -58,10 +68,17 @@ def main(argv: list[str] | None = None) -> int:
         app = create_app(settings, client, scenario.site, vocabulary, workers)
         server = uvicorn.Server(
             uvicorn.Config(
-                app, host=settings.host, port=settings.port, log_config=None, access_log=False
+                app,
+                host=settings.host,
+                port=settings.port,
+                log_config=None,
+                access_log=False,
+                ssl_certfile=args.tls_cert,
+                ssl_keyfile=args.tls_key,
             )
         )
-        log.info("gateway on http://%s:%d", settings.host, settings.port)
+        scheme = "https" if args.tls_cert else "http"
+        log.info("gateway on %s://%s:%d", scheme, settings.host, settings.port)
         asyncio.run(server.serve())
     log.info("gateway stopped")
     return 0

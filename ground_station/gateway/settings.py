@@ -22,6 +22,26 @@ class GatewaySettings:
     gestures: str | None = None  # a YAML gesture vocabulary (default: the shipped one)
 
 
+DEV_TOKEN = "linecrew-dev-token"
+"""The token docker-compose.yml falls back to: public, so refused unless
+``LINECREW_ALLOW_DEV_TOKEN=1`` says this is a development run."""
+
+
+class DevTokenRefused(ValueError):
+    """The gateway was given the public development token without the flag."""
+
+
+def check_token(token: str) -> str:
+    """``token``, unless it is :data:`DEV_TOKEN` and ``LINECREW_ALLOW_DEV_TOKEN``
+    is not 1 (then :class:`DevTokenRefused` says what to do)."""
+    if token == DEV_TOKEN and os.environ.get("LINECREW_ALLOW_DEV_TOKEN") != "1":
+        raise DevTokenRefused(
+            f"the token {DEV_TOKEN!r} is public: set LINECREW_TOKEN to a secret "
+            "(e.g. `openssl rand -hex 24`), or LINECREW_ALLOW_DEV_TOKEN=1 for a development run"
+        )
+    return token
+
+
 def resolve_token(token: str | None, token_file: str | None) -> str:
     """The bearer token: given, else read from ``token_file``, else
     ``LINECREW_TOKEN``, else a new random one (written to ``token_file`` if set)."""
@@ -31,7 +51,7 @@ def resolve_token(token: str | None, token_file: str | None) -> str:
         return pathlib.Path(token_file).read_text().strip()
     if env := os.environ.get("LINECREW_TOKEN"):
         return env
-    fresh = secrets.token_urlsafe(24)
+    fresh = secrets.token_hex(24)  # never starts with "-" (an option to argparse)
     if token_file:
         path = pathlib.Path(token_file)
         path.write_text(fresh + "\n")

@@ -17,7 +17,7 @@ import msgspec
 from proto.geo import Point
 from proto.keys import KeySpace
 from proto.site import Site
-from proto.telemetry import HumanPose
+from proto.telemetry import POSE_FUTURE_S, HumanPose
 
 
 class WorkerView(msgspec.Struct, frozen=True, kw_only=True):
@@ -49,8 +49,12 @@ class WorkerPoses:
         self.refused = 0  # poses dropped: key and payload disagree, or no such worker
 
     def on_pose(self, key: str, pose: HumanPose) -> None:
-        """Keep ``pose`` if its key names its worker, a worker of the site."""
+        """Keep ``pose`` if its key names its worker, a worker of the site, and
+        it is not stamped beyond :data:`POSE_FUTURE_S` ahead."""
         if pose.worker_id not in self._known or not self.keys.owns(key, "human", pose.worker_id):
+            self.refused += 1
+            return
+        if pose.stamp_s > self.clock() + POSE_FUTURE_S:
             self.refused += 1
             return
         with self._lock:

@@ -44,6 +44,13 @@ class AsyncQueue(Generic[T]):
         """The next item, waiting for one."""
         return await self._queue.get()
 
+    def drain(self) -> list[T]:
+        """Every item waiting now (none: an empty list), without waiting."""
+        items = []
+        while not self._queue.empty():
+            items.append(self._queue.get_nowait())
+        return items
+
     def __aiter__(self) -> AsyncQueue[T]:
         return self
 

@@ -23,6 +23,7 @@ from linecrew.bus.config import BusConfig
 from linecrew.bus.handoff import AsyncQueue
 from linecrew.bus.stats import BusStats
 from proto import codec
+from proto.base import MAX_TEXT
 from proto.errors import (
     DecodeError,
     EncodeError,
@@ -75,6 +76,10 @@ class Declared:
     async def get(self) -> Any:
         """The next item of an async subscription."""
         return await self.__aiter__().get()
+
+    def drain(self) -> list[Any]:
+        """Every item of an async subscription waiting now, without waiting."""
+        return self.__aiter__().drain()
 
 
 class Bus:
@@ -224,9 +229,8 @@ class Bus:
                 result = handler(key, request) if with_key else handler(request)
                 reply = await result if inspect.isawaitable(result) else result
             except LinecrewError as exc:
-                reply = ErrorReply(
-                    code=exc.code, message=exc.message, field=getattr(exc, "field", None)
-                )
+                field = getattr(exc, "field", None)
+                reply = ErrorReply(code=exc.code, message=exc.message[:MAX_TEXT], field=field)
             except Exception:
                 log.exception("query handler failed on %s", key)
                 reply = ErrorReply(code="internal_error", message="the server failed; see its log")
@@ -237,7 +241,9 @@ class Bus:
                     query.reply(key, codec.encode(reply))
             except EncodeError as exc:  # a reply too large (or absurd) still answers
                 log.warning("cannot encode the reply on %s: %s", key, exc)
-                error = ErrorReply(code=exc.code, message=f"the reply cannot be sent: {exc}")
+                error = ErrorReply(
+                    code=exc.code, message=f"the reply cannot be sent: {exc}"[:MAX_TEXT]
+                )
                 with contextlib.suppress(zenoh.ZError):
                     query.reply_err(codec.encode(error))
             except (zenoh.ZError, LinecrewError) as exc:

@@ -99,9 +99,7 @@ class ChaosRunner:
         run_options = RunOptions(speedup=opts.speedup, run_dir=opts.run_dir)
         with LocalRun(self.scenario, run_options) as run:
             faults = ProcessFaults(run)
-            http = httpx.Client(
-                base_url=run.url, headers={"Authorization": f"Bearer {run.token}"}, timeout=4.0
-            )
+            http = run.http(timeout_s=4.0)
             try:
                 samples, actions = self._loop(run, faults, http)
                 events = self._event_counts(run)

@@ -82,7 +82,7 @@ def _run(args: argparse.Namespace, work: Callable[[Gateway], Any], show: Callabl
     if target is None:
         return 1
     try:
-        result = work(Gateway(target.url, target.token))
+        result = work(target.gateway())
     except GatewayError as exc:
         print(f"linecrew: {exc}", file=sys.stderr)
         return 1
@@ -243,7 +243,7 @@ def plan_main(argv: list[str]) -> int:
     target = _target(args)
     if target is None:
         return 1
-    gateway = Gateway(target.url, target.token)
+    gateway = target.gateway()
     try:
         plans = gateway.call("GET", "/v1/plan")
         fleet = [] if args.json else gateway.call("GET", "/v1/fleet")
@@ -285,7 +285,7 @@ def events_main(argv: list[str]) -> int:
     if target is None:
         return 1
     try:
-        for event in Gateway(target.url, target.token).events(args.after):
+        for event in target.gateway().events(args.after):
             if args.json:
                 print(json.dumps(event), flush=True)
             else:

@@ -4,6 +4,8 @@
 from __future__ import annotations
 
 import json
+import os
+import ssl
 from collections.abc import Iterator
 from typing import Any
 
@@ -24,14 +26,36 @@ class GatewayError(LinecrewError):
         self.body = body  # the decoded JSON error ({"error", "message", "field"}), if any
 
 
+CA_ENV = "LINECREW_CA_FILE"
+"""The CA that an HTTPS gateway's certificate is checked against (a
+``--secure`` run's site CA); unset, the system's trust store."""
+
+
+def tls_verify(ca_file: str | None = None) -> ssl.SSLContext | bool:
+    """How to check an HTTPS gateway: against ``ca_file``, else ``$LINECREW_CA_FILE``,
+    else the system's CAs."""
+    ca_file = ca_file or os.environ.get(CA_ENV)
+    return ssl.create_default_context(cafile=ca_file) if ca_file else True
+
+
+def http_client(url: str, token: str, *, ca_file: str | None = None, timeout_s: float = 10.0):
+    """An ``httpx.Client`` for the gateway at ``url``: the bearer token, the CA."""
+    return httpx.Client(
+        base_url=url,
+        timeout=timeout_s,
+        headers={"Authorization": f"Bearer {token}"},
+        verify=tls_verify(ca_file),
+    )
+
+
 class Gateway:
     """A thin client: JSON in, JSON out, errors as :class:`GatewayError`."""
 
-    def __init__(self, url: str, token: str, timeout_s: float = 10.0) -> None:
+    def __init__(
+        self, url: str, token: str, timeout_s: float = 10.0, *, ca_file: str | None = None
+    ) -> None:
         self.url = url
-        self._http = httpx.Client(
-            base_url=url, timeout=timeout_s, headers={"Authorization": f"Bearer {token}"}
-        )
+        self._http = http_client(url, token, ca_file=ca_file, timeout_s=timeout_s)
 
     def call(self, method: str, path: str, **kwargs: Any) -> Any:
         """Send a request; the decoded JSON answer."""

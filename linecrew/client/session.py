@@ -29,6 +29,8 @@ from collections.abc import Iterator
 
 import httpx
 
+from linecrew.client.gateway import Gateway, tls_verify
+
 SESSION_ENV = "LINECREW_SESSION"
 SESSION_NAME = pathlib.Path(".linecrew") / "session.json"
 
@@ -48,6 +50,7 @@ class RunEntry:
     started_s: float = 0.0  # UNIX seconds
     speedup: float | None = None  # unknown in the old one-run format
     scenario: str = ""
+    ca_file: str = ""  # the CA of an HTTPS gateway (a --secure run's site CA)
 
     def describe(self) -> str:
         """``run DIR (gateway URL, scenario S, xK)``."""
@@ -139,10 +142,14 @@ def unregister(url: str, path: pathlib.Path) -> None:
             _write(path, kept)
 
 
-def healthy(url: str, timeout_s: float = 1.0) -> bool:
-    """Whether a gateway answers ``/healthz``."""
+def healthy(url: str, timeout_s: float = 1.0, ca_file: str | None = None) -> bool:
+    """Whether a gateway answers ``/healthz`` (over HTTPS: with a certificate
+    ``ca_file`` vouches for)."""
     try:
-        return httpx.get(f"{url.rstrip('/')}/healthz", timeout=timeout_s).status_code == 200
+        answer = httpx.get(
+            f"{url.rstrip('/')}/healthz", timeout=timeout_s, verify=tls_verify(ca_file)
+        )
+        return answer.status_code == 200
     except httpx.HTTPError:
         return False
 
@@ -156,7 +163,7 @@ def live_run(path: pathlib.Path | None = None) -> RunEntry:
         where = f"{path} does not exist" if not path.exists() else f"{path} lists no run"
         raise NoRunError(f"no linecrew run found ({where}); {hint}")
     for run in sorted(runs, key=lambda r: r.started_s, reverse=True):
-        if healthy(run.url):
+        if healthy(run.url, ca_file=run.ca_file or None):
             return run
     raise NoRunError(
         f"no linecrew run is up: none of the {len(runs)} run(s) in {path} answers; {hint}"
@@ -170,6 +177,12 @@ class Target:
     url: str
     token: str
     run: RunEntry | None = None  # when found through the session file
+
+    def gateway(self) -> Gateway:
+        """A client of this gateway (HTTPS checked against the run's CA, else
+        ``$LINECREW_CA_FILE``)."""
+        ca_file = self.run.ca_file if self.run and self.run.ca_file else None
+        return Gateway(self.url, self.token, ca_file=ca_file)
 
 
 def resolve(url: str | None, token: str | None, *, announce: bool = True) -> Target:
@@ -188,7 +201,12 @@ def resolve(url: str | None, token: str | None, *, announce: bool = True) -> Tar
 
 
 def entry_for(
-    url: str, token: str, run_dir: pathlib.Path, speedup: float, scenario: str
+    url: str,
+    token: str,
+    run_dir: pathlib.Path,
+    speedup: float,
+    scenario: str,
+    ca_file: str | None = None,
 ) -> RunEntry:
     """The entry this process registers for a run it started."""
     return RunEntry(
@@ -199,4 +217,5 @@ def entry_for(
         started_s=time.time(),
         speedup=speedup,
         scenario=scenario,
+        ca_file=ca_file or "",
     )

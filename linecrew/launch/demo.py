@@ -21,7 +21,7 @@ from rich.console import Console
 from rich.progress import BarColumn, Progress, TextColumn
 from rich.table import Table
 
-from linecrew.client.gateway import Gateway, GatewayError
+from linecrew.client.gateway import GatewayError
 from linecrew.client.render import timeline
 from linecrew.launch.local_run import LocalRun
 from linecrew.launch.narrate import Narrator, intro, outcome_text
@@ -61,7 +61,7 @@ def run_mission(
     ``on_tick(mission_s_since_start, records)`` runs every half second (tests
     inject faults there). With a ``narrator`` (its inbox fed by the event
     subscription), its lines are printed above the progress bars."""
-    gateway = Gateway(run.url, run.token)
+    gateway = run.gateway()
     recorder = ExecutionRecorder()
     pending = sorted(scenario.actions, key=lambda a: a.at_s)
     started = time.monotonic()

@@ -24,6 +24,7 @@ import msgspec
 from linecrew.bus import Bus, BusConfig
 from linecrew.bus.router_process import free_port, port_open
 from linecrew.client import session
+from linecrew.client.gateway import Gateway, http_client
 from linecrew.launch import secure
 from linecrew.launch.flight_log import FlightLog
 from linecrew.launch.ports import free_udp_block
@@ -62,6 +63,7 @@ class LocalRun:
         self.endpoint = ""
         self.url = ""
         self.token = ""
+        self.ca_file: str | None = None  # the site CA, when the gateway serves HTTPS
         self.mavlink_ports: dict[str, int] = {}  # UAV id -> its simulated autopilot's UDP port
         self.bus: Bus | None = None
         self.flight_log: FlightLog | None = None
@@ -164,7 +166,11 @@ class LocalRun:
         sup.wait_ready(sim, lambda: self._alive(Role.SIM, "sim"), wait)
 
         gateway_port = opts.gateway_port or free_port()
-        self.url = f"http://127.0.0.1:{gateway_port}"
+        https = (
+            ["--tls-cert", profile.https()[0], "--tls-key", profile.https()[1]] if profile else []
+        )
+        self.ca_file = profile.ca() if profile else None
+        self.url = f"{'https://localhost' if profile else 'http://127.0.0.1'}:{gateway_port}"
         token_file = self.run_dir / "token"
         gateway = sup.start(
             "gateway",
@@ -176,13 +182,14 @@ class LocalRun:
             str(gateway_port),
             "--token-file",
             str(token_file),
+            *https,
         )
         sup.wait_ready(gateway, self._gateway_healthy, wait)
         self.token = token_file.read_text().strip()
         self._describe(started_s)
         if opts.register:
             entry = session.entry_for(
-                self.url, self.token, self.run_dir, opts.speedup, self.scenario.name
+                self.url, self.token, self.run_dir, opts.speedup, self.scenario.name, self.ca_file
             )
             self.session_file = session.register(entry, opts.session_file)
 
@@ -221,7 +228,12 @@ class LocalRun:
         return key in self.bus.alive(key, timeout_s=0.5)
 
     def _gateway_healthy(self) -> bool:
-        try:
-            return httpx.get(f"{self.url}/healthz", timeout=1.0).status_code == 200
-        except httpx.HTTPError:
-            return False
+        return session.healthy(self.url, ca_file=self.ca_file)
+
+    def gateway(self) -> Gateway:
+        """A client of this run's gateway."""
+        return Gateway(self.url, self.token, ca_file=self.ca_file)
+
+    def http(self, timeout_s: float = 10.0) -> httpx.Client:
+        """A raw ``httpx.Client`` of this run's gateway (token and CA set)."""
+        return http_client(self.url, self.token, ca_file=self.ca_file, timeout_s=timeout_s)

@@ -41,6 +41,14 @@ class SecureProfile:
         """The config of ``identity`` (``gs``, ``sim``, ``uav-2``, ...)."""
         return str(self.root / "zenoh" / f"client-{identity}.json5")
 
+    def ca(self) -> str:
+        """The site CA: clients of the gateway's HTTPS verify against it."""
+        return str(self.root / "ca.pem")
+
+    def https(self) -> tuple[str, str]:
+        """The gateway's HTTPS certificate and key."""
+        return str(self.root / "https.pem"), str(self.root / "https.key")
+
     def mavlink_keys(self) -> str:
         """The directory of every vehicle's MAVLink key (``uav-K.key``)."""
         return str(self.root / "mavlink")

@@ -17,7 +17,6 @@ from urllib.parse import urlsplit
 import msgspec
 import pytest
 
-from linecrew.client.gateway import Gateway
 from linecrew.launch.local_run import LocalRun, RunOptions
 from linecrew.scenarios import load
 from tests.support.processes import wait_until
@@ -37,7 +36,7 @@ def run(tmp_path_factory, browser):
 
 @pytest.fixture
 def gateway(run):
-    return Gateway(run.url, run.token)
+    return run.gateway()
 
 
 def open_console(new_page, run, fragment: str | None = None):

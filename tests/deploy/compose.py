@@ -103,7 +103,7 @@ class Stack:
         self.project = f"linecrew-test-{os.getpid()}-{secrets.token_hex(3)}"
         self.compose = compose
         self.speedup = speedup
-        self.token = secrets.token_urlsafe(16)
+        self.token = secrets.token_hex(16)
         # Nothing of the developer's LINECREW_* settings leaks into the stack.
         env = {k: v for k, v in os.environ.items() if not k.startswith("LINECREW_")}
         env.update(

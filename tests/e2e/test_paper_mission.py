@@ -11,7 +11,6 @@ import signal
 import pytest
 from rich.console import Console
 
-from linecrew.client.gateway import Gateway
 from linecrew.launch.demo import run_mission
 from linecrew.launch.local_run import LocalRun, RunOptions
 from linecrew.process import Shutdown
@@ -76,7 +75,7 @@ def test_the_papers_scenario_completes_through_rest(run):
 
 def test_battery_fault_and_a_killed_agent_mid_mission_still_complete(run):
     watch = LandingWatch(run)
-    gateway = Gateway(run.url, run.token)
+    gateway = run.gateway()
     done: set[str] = set()
 
     def inject(mission_s: float, records: list[dict]) -> None:

@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import shutil
 
+import httpx
 import pytest
 
 from linecrew.bus import Bus, BusConfig
@@ -26,6 +27,12 @@ def test_the_papers_scenario_completes_on_the_secured_bus(tmp_path):
         with pytest.raises(Exception):  # noqa: B017 - zenoh raises a bare ZError
             Bus.open(BusConfig(connect=(plain,), connect_attempt_ms=500))
         assert (run.run_dir / "tls" / "mavlink" / "uav-1.key").stat().st_mode & 0o077 == 0
+        assert run.url.startswith("https://")  # REST over TLS, vouched for by the site CA
+        with pytest.raises(httpx.HTTPError):  # a client that does not trust the site CA
+            httpx.get(f"{run.url}/healthz", timeout=5.0)
+        with pytest.raises(httpx.HTTPError):  # plain HTTP is not answered
+            httpx.get(run.url.replace("https://", "http://") + "/healthz", timeout=5.0)
+        assert len(run.gateway().call("GET", "/v1/fleet")) == len(PAPER.fleet.uavs)
         stranger = Client(run.mavlink_ports["uav-1"], 1, streams_hz=0)
         try:
             arm = mavlink.MAV_CMD_COMPONENT_ARM_DISARM

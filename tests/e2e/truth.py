@@ -12,7 +12,7 @@ import itertools
 import math
 from collections.abc import Callable
 
-from linecrew.client.gateway import Gateway, GatewayError
+from linecrew.client.gateway import GatewayError
 from linecrew.launch.local_run import LocalRun
 from proto import GetHistory, GetSimState, GsEvent, HistoryReply, Point, SimState
 from tests.support.processes import wait_until
@@ -35,7 +35,7 @@ class TruthLog:
 
     def __init__(self, run: LocalRun) -> None:
         self.run = run
-        self.gateway = Gateway(run.url, run.token)
+        self.gateway = run.gateway()
         self.samples: list[Sample] = []
 
     def sample(self) -> SimState:

@@ -53,6 +53,12 @@ def test_submission_is_idempotent_on_the_request_id(gs):
     with pytest.raises(Conflict) as caught:
         gs.manager.submit(SubmitAction(request_id="same", action=other))
     assert caught.value.field == "request_id"
+    same = gs.store.action(first.action_id).action
+    with pytest.raises(Conflict) as caught:  # the same action under another id: not a replay
+        gs.manager.submit(SubmitAction(request_id="same", action=same, action_id="other-id"))
+    assert caught.value.field == "action_id" and gs.store.action("other-id") is None
+    replay = SubmitAction(request_id="same", action=same, action_id=first.action_id)
+    assert gs.manager.submit(replay) == first
 
 
 def test_an_invalid_action_is_refused_and_nothing_is_stored(gs):

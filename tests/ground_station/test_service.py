@@ -242,6 +242,22 @@ def test_a_sample_whose_uav_disagrees_with_its_key_is_dropped_and_counted(client
     assert not [e for e in history(client).events if e.kind == EventKind.UAV_LOST]
 
 
+def test_a_sample_stamped_far_in_the_future_is_dropped_and_counted(client, agents):
+    submit(client, "deliver-wrench")
+    uav1 = agents["uav-1"]
+    wait_until(lambda: owner_of(agents, "deliver-wrench") is uav1, 10, "the delivery at uav-1")
+    ahead = time.time() + 3600  # on its own key, but an hour ahead of the mission clock
+    status = AgentStatus(uav_id="uav-1", stamp_s=ahead, state=AgentState.EMERGENCY)
+    uav1.bus.publish(KEYS.uav("uav-1", UavTopic.STATUS), status)
+
+    def dropped() -> float:
+        metrics = client.query(KEYS.rpc("metrics"), GetMetrics(), MetricsReply, 5.0)
+        return metrics.values["bus_future_stamps"]
+
+    wait_until(lambda: dropped() >= 1, 10, "the future-stamped status counted")
+    assert owner_of(agents, "deliver-wrench") is uav1  # the forged emergency took nothing
+
+
 def test_a_uav_reads_only_its_own_plan(client, agents):
     submit(client, "deliver-wrench")
     wait_until(lambda: agents["uav-1"].latest().tasks, 10, "uav-1 has work")

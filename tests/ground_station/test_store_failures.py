@@ -60,6 +60,8 @@ def test_events_the_store_cannot_take_are_published_and_stored_in_order_later(di
     log.emit(EventKind.FAULT, detail="during")
     assert [e.seq for e in published] == [1, 2, 3]  # said at once
     assert [e.seq for e in store.events()] == [1] and log.unstored == 2
+    assert [e.seq for e in log.after(0, 10)] == [1, 2, 3] and log.last_seq == 3  # all readable
+    assert [e.seq for e in log.after(1, 1)] == [2]
     log.flush()  # still full: nothing lost, nothing reordered
     assert log.unstored == 2
     disk.free()

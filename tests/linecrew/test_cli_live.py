@@ -17,7 +17,6 @@ import msgspec
 import pytest
 
 from linecrew.client import session
-from linecrew.client.gateway import Gateway
 from linecrew.launch.local_run import LocalRun, RunOptions
 from linecrew.scenarios import load
 from tests.support.processes import wait_until
@@ -35,7 +34,7 @@ def run(tmp_path_factory, private_session_file):
 
 @pytest.fixture(scope="module")
 def gateway(run):
-    return Gateway(run.url, run.token)
+    return run.gateway()
 
 
 def cli(*args: str, env: dict | None = None, **kwargs) -> subprocess.CompletedProcess:
@@ -85,7 +84,7 @@ def test_a_newer_dead_run_in_the_session_file_is_skipped(run, private_session_fi
 
 def test_an_explicit_url_works_without_any_session_file(run, tmp_path):
     env = {"LINECREW_SESSION": str(tmp_path / "none.json")}
-    done = cli("status", "--json", "--url", run.url, "--token", run.token, env=env)
+    done = cli("status", "--json", "--url", run.url, f"--token={run.token}", env=env)
     assert done.returncode == 0, done.stderr
     assert len(json.loads(done.stdout)) == 3 and done.stderr == ""
     nothing = cli("status", env=env)

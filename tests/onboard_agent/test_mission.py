@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from onboard_agent import Mission, PlanVerdict
+from onboard_agent.mission import EPOCH_LEAD
 from proto.plan import DeliverTask, GoHomeTask, InspectTask, MonitorTask, PickTask, RechargeTask
 from proto.telemetry import OutcomeResult
 from tests.onboard_agent.helpers import SCENARIO, inspect_task, plan, point
@@ -26,6 +27,25 @@ class TestEpochFencing:
         assert m.offer(plan(inspect_task("c"), epoch=5)) is PlanVerdict.STALE
         assert [t.task_id for t in m.tasks] == ["a"] and m.epoch == 5
         assert m.take_outcomes() == []
+
+    def test_an_epoch_far_ahead_of_the_announced_one_is_held_until_announced(self):
+        m = mission()
+        m.announce("gs-a", 10)
+        forged = plan(inspect_task("x"), epoch=2**52)  # would fence out every real plan
+        assert m.offer(forged) is PlanVerdict.UNANNOUNCED and m.epoch == 0
+        assert m.offer(plan(inspect_task("a"), epoch=11)) is PlanVerdict.ACCEPTED
+        assert m.announce("gs-a", 12) is None  # the held plan waits for its epoch...
+        assert (
+            m.offer(plan(inspect_task("b"), epoch=12 + EPOCH_LEAD + 5)) is PlanVerdict.UNANNOUNCED
+        )
+        assert m.announce("gs-a", 13) is None  # ...still not covered: held
+        assert [t.task_id for t in m.tasks] == ["a"] and m.epoch == 11
+
+    def test_a_held_plan_is_adopted_once_an_announcement_covers_it(self):
+        m = mission()  # a restarted agent: nothing announced yet
+        assert m.offer(plan(inspect_task("a"), epoch=500)) is PlanVerdict.UNANNOUNCED
+        assert m.announce("gs-b", 500) is PlanVerdict.ACCEPTED
+        assert [t.task_id for t in m.tasks] == ["a"] and m.epoch == 500
 
     def test_plan_for_another_uav_is_rejected_with_failures(self):
         m = mission()

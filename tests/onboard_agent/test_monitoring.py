@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+import time
 
 import msgspec
 import pytest
@@ -75,6 +76,18 @@ def test_stale_poses_are_ignored():
     rig.agent.human_pose(new)
     rig.agent.human_pose(old)
     assert rig.agent.ctx.surroundings.worker_position("W2") == point(1, 1, 3)
+
+
+def test_a_pose_stamped_from_the_future_is_refused_and_later_real_poses_still_count():
+    rig = Rig()
+    surroundings = rig.agent.ctx.surroundings
+    forged = HumanPose(
+        worker_id="W2", stamp_s=time.time() + 3600, position=point(9, 9, 3), geo=GeoPoint()
+    )
+    rig.agent.human_pose(forged)
+    real = HumanPose(worker_id="W2", stamp_s=time.time(), position=point(1, 1, 3), geo=GeoPoint())
+    rig.agent.human_pose(real)
+    assert surroundings.worker_position("W2") == point(1, 1, 3) and surroundings.refused == 1
 
 
 def test_a_timed_segment_holds_clear_of_the_slot_until_its_window_then_leaves_at_its_end():

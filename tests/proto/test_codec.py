@@ -158,3 +158,42 @@ def test_decoders_are_built_once_even_when_threads_race_for_them():
     assert len(built) == 16 and all(d is built[0] for d in built)
     message = Fresh(plan=_plan())
     assert codec.decode(codec.encode(message), Fresh) == message
+
+
+def _telemetry(**changes) -> proto.Telemetry:
+    fields = dict(
+        uav_id="uav-1",
+        stamp_s=1.0,
+        position=proto.Point(x_m=1, y_m=2, z_m=3),
+        geo=proto.GeoPoint(lat_deg=45, lon_deg=7, alt_m=300),
+        battery_wh=100,
+        battery_fraction=0.5,
+    )
+    return proto.Telemetry(**(fields | changes))
+
+
+@pytest.mark.parametrize("bad", [float("nan"), float("inf"), -float("inf"), 1e308])
+def test_a_non_finite_or_absurd_float_is_refused(bad):
+    for message in (
+        _telemetry(position=proto.Point(x_m=bad, y_m=0)),
+        _telemetry(stamp_s=bad),
+        _telemetry(battery_wh=abs(bad)),
+        proto.HumanPose(
+            worker_id="w1", stamp_s=1, position=proto.Point(x_m=0, y_m=bad), geo=proto.GeoPoint()
+        ),
+    ):
+        with pytest.raises(DecodeError, match="Expected `float`"):
+            codec.decode(codec.encode(message), type(message))
+
+
+def test_strings_on_the_wire_have_length_limits():
+    status = dict(uav_id="uav-1", stamp_s=1.0, state=proto.AgentState.IDLE)
+    codec.decode(codec.encode(proto.AgentStatus(**status, reason="r" * 4096)), proto.AgentStatus)
+    for too_long in (
+        proto.AgentStatus(**status, reason="r" * 4097),
+        proto.AgentStatus(**status, active_path=["node"] * 65),
+        proto.CancelAction(request_id="q" * 129, action_id="a1"),
+        proto.CancelAction(request_id="", action_id="a1"),
+    ):
+        with pytest.raises(DecodeError, match="length"):
+            codec.decode(codec.encode(too_long), type(too_long))

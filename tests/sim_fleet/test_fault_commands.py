@@ -17,7 +17,7 @@ from proto import (
     Point,
 )
 from proto.site import TimedPoint, Worker
-from sim_fleet.faults import UnknownTarget, apply_fault
+from sim_fleet.faults import OutsideSite, UnknownTarget, apply_fault
 from sim_fleet.from_proto import scenario_from_proto
 from sim_fleet.truth import sim_state
 from sim_fleet.workers import worker_position
@@ -32,36 +32,47 @@ def world():
 
 
 def test_battery_fault_sets_the_charge(world):
-    reply = apply_fault(world, BatteryFault(uav_id="uav-1", fraction=0.25))
+    reply = apply_fault(world, BatteryFault(uav_id="uav-1", fraction=0.25), PAPER.site)
     assert world.vehicle("uav-1").battery.soc == pytest.approx(0.25)
     assert reply.target == "uav-1" and "25%" in reply.detail
 
 
 def test_motor_link_and_gps_faults_reach_the_vehicle(world):
-    apply_fault(world, MotorFailure(uav_id="uav-2"))
-    apply_fault(world, LinkDrop(uav_id="uav-3", duration_s=7))
-    apply_fault(world, GpsFreeze(uav_id="uav-1", duration_s=3))
+    apply_fault(world, MotorFailure(uav_id="uav-2"), PAPER.site)
+    apply_fault(world, LinkDrop(uav_id="uav-3", duration_s=7), PAPER.site)
+    apply_fault(world, GpsFreeze(uav_id="uav-1", duration_s=3), PAPER.site)
     assert world.vehicle("uav-2").motors_failed
     assert world.vehicle("uav-3").link_down_until == pytest.approx(7)
     assert world.vehicle("uav-1").gps_frozen_until == pytest.approx(3)
 
 
 def test_drain_kill_gripper_and_worker_faults(world):
-    apply_fault(world, DrainFault(uav_id="uav-1", multiplier=3))
-    apply_fault(world, KillVehicle(uav_id="uav-2"))
-    apply_fault(world, GripperFailure(uav_id="uav-1"))
-    reply = apply_fault(world, MoveWorker(worker_id="W2", position=Point(x_m=1, y_m=2, z_m=3)))
+    apply_fault(world, DrainFault(uav_id="uav-1", multiplier=3), PAPER.site)
+    apply_fault(world, KillVehicle(uav_id="uav-2"), PAPER.site)
+    apply_fault(world, GripperFailure(uav_id="uav-1"), PAPER.site)
+    reply = apply_fault(
+        world, MoveWorker(worker_id="W2", position=Point(x_m=1, y_m=2, z_m=3)), PAPER.site
+    )
     assert world.vehicle("uav-1").drain_multiplier == 3
     assert world.vehicle("uav-2").motors_failed and world.vehicle("uav-2").link_down_until > 1e9
     assert world.vehicle("uav-1").gripper_failed
     assert world.workers["W2"] == (1, 2, 3) and reply.target == "W2"
     with pytest.raises(UnknownTarget, match="no worker 'W9'"):
-        apply_fault(world, MoveWorker(worker_id="W9", position=Point(x_m=0, y_m=0)))
+        apply_fault(world, MoveWorker(worker_id="W9", position=Point(x_m=0, y_m=0)), PAPER.site)
+
+
+@pytest.mark.parametrize("x_m", [1e308, -1e6, 5_000])
+def test_a_worker_is_never_moved_outside_the_site(world, x_m):
+    before = world.workers["W2"]
+    away = MoveWorker(worker_id="W2", position=Point(x_m=x_m, y_m=0))
+    with pytest.raises(OutsideSite, match="outside the site's area") as caught:
+        apply_fault(world, away, PAPER.site)
+    assert caught.value.field == "position" and world.workers["W2"] == before
 
 
 def test_unknown_uav_is_a_clear_error(world):
     with pytest.raises(UnknownTarget, match="known: uav-1, uav-2, uav-3") as caught:
-        apply_fault(world, MotorFailure(uav_id="ghost"))
+        apply_fault(world, MotorFailure(uav_id="ghost"), PAPER.site)
     assert caught.value.field == "uav_id"
 
 

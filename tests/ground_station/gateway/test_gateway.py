@@ -9,6 +9,8 @@ import json
 import httpx
 import pytest
 
+from linecrew.bus import Bus
+from proto import EventKind, GsEvent, KeySpace
 from tests.support.processes import wait_until
 
 DELIVER = {"type": "deliver", "tool": "wrench", "tool_station_id": "tp-wrench", "worker_id": "W1"}
@@ -102,6 +104,29 @@ def test_events_stream_replays_history_then_follows(gateway):
             if any(e["kind"] == "action_accepted" for e in seen):
                 break
     assert seen[0]["seq"] == 1
+
+
+def test_a_forged_event_on_the_bus_neither_reaches_the_stream_nor_hides_real_ones(
+    gateway, bus_config
+):
+    """Live frames are read from the ground station's log: a sample on the
+    events key with a huge ``seq`` is only a wake-up."""
+    forged = GsEvent(seq=2**52, stamp_s=0.0, kind=EventKind.ACTION_ACCEPTED, detail="forged")
+    stream_client = httpx.Client(
+        base_url=gateway.base_url, headers=gateway.headers, timeout=10.0
+    )  # a read timeout (no keep-alive within 10 s) fails the test rather than hanging it
+    seen: list[dict] = []
+    with Bus.open(bus_config) as bus, stream_client.stream("GET", "/v1/events") as stream:
+        lines = stream.iter_lines()
+        assert next(line for line in lines if line.startswith(":")) == ": connected"
+        bus.publish(KeySpace().events(), forged)
+        assert gateway.post("/v1/actions", json=DELIVER).status_code == 201
+        for line in lines:
+            if line.startswith("data: "):
+                seen.append(json.loads(line[6:]))
+            if any(e["kind"] == "action_accepted" for e in seen):
+                break
+    assert all(e["detail"] != "forged" and e["seq"] < 100 for e in seen), seen
 
 
 def test_fault_without_a_simulator_is_503_not_a_hang(gateway):

@@ -11,7 +11,7 @@ from tests.ground_station.gateway.conftest import TOKEN
 
 def linecrew(url: str, command: str, *args: str, token: str = TOKEN):
     """Run ``linecrew COMMAND --url URL --token TOKEN ARGS...``."""
-    argv = [sys.executable, "-m", "linecrew.cli", command, "--url", url, "--token", token, *args]
+    argv = [sys.executable, "-m", "linecrew.cli", command, "--url", url, f"--token={token}", *args]
     return subprocess.run(argv, capture_output=True, text=True, timeout=60)
 
 
