@@ -21,7 +21,7 @@ from rich.console import Console
 from rich.progress import BarColumn, Progress, TextColumn
 from rich.table import Table
 
-from linecrew.client.gateway import GatewayError
+from linecrew.client.gateway import Gateway, GatewayError
 from linecrew.client.render import timeline
 from linecrew.launch.local_run import LocalRun
 from linecrew.launch.narrate import Narrator, intro, outcome_text
@@ -48,7 +48,7 @@ completed.
 
 
 def run_mission(
-    run: LocalRun,
+    gateway: Gateway,
     scenario: Scenario,
     speedup: float,
     timeout_s: float,
@@ -61,7 +61,6 @@ def run_mission(
     ``on_tick(mission_s_since_start, records)`` runs every half second (tests
     inject faults there). With a ``narrator`` (its inbox fed by the event
     subscription), its lines are printed above the progress bars."""
-    gateway = run.gateway()
     recorder = ExecutionRecorder()
     pending = sorted(scenario.actions, key=lambda a: a.at_s)
     started = time.monotonic()
@@ -160,8 +159,9 @@ def main(argv: list[str] | None = None) -> int:
             narrator = Narrator(start)
             assert run.bus is not None
             run.bus.subscribe(run.keys.events(), GsEvent, lambda _k, e: narrator.inbox.put(e))
+            gateway = run.gateway()
             records, recorder = run_mission(
-                run, scenario, args.speedup, args.timeout, shutdown, console, narrator=narrator
+                gateway, scenario, args.speedup, args.timeout, shutdown, console, narrator=narrator
             )
             truth = run.bus.query(run.keys.sim("state"), GetSimState(), SimState, 5.0)
     except (ScenarioError, StartError, GatewayError, SecureProfileError) as exc:

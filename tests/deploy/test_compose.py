@@ -11,12 +11,12 @@ from __future__ import annotations
 import io
 import sys
 import time
-import types
 
 import msgspec
 import pytest
 from rich.console import Console
 
+from linecrew.client.gateway import Gateway
 from linecrew.launch.demo import TERMINAL, run_mission
 from linecrew.process import Shutdown
 from linecrew.scenarios import load
@@ -54,7 +54,7 @@ def renamed(scenario: Scenario, prefix: str, tool: str) -> Scenario:
 def fly(stack: Stack, scenario: Scenario, on_tick=None) -> dict[str, str]:
     """Submit the scenario's actions on time through REST (as ``linecrew
     demo``) and follow them until all end; action id -> final state."""
-    gateway = types.SimpleNamespace(url=stack.url, token=stack.token)
+    gateway = Gateway(stack.url, stack.token)
     console = Console(file=io.StringIO())
     records, _ = run_mission(
         gateway, scenario, SPEEDUP, MISSION_TIMEOUT_S, Shutdown(), console, on_tick

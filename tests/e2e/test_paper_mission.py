@@ -51,7 +51,7 @@ def run(tmp_path):
 
 def fly(run: LocalRun, on_tick=None):
     console = Console(file=io.StringIO())
-    return run_mission(run, PAPER, SPEEDUP, TIMEOUT_S, Shutdown(), console, on_tick)
+    return run_mission(run.gateway(), PAPER, SPEEDUP, TIMEOUT_S, Shutdown(), console, on_tick)
 
 
 def test_the_papers_scenario_completes_through_rest(run):
