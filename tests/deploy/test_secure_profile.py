@@ -28,11 +28,19 @@ from linecrew import health
 from linecrew.bus import Bus, BusConfig
 from proto.errors import RequestTimeout, Unavailable
 from proto.geo import GeoPoint, Point
-from proto.keys import KeySpace, Role
+from proto.keys import KeySpace, Role, UavTopic
 from proto.plan import Plan
-from proto.rpc import GetPlans, PlansReply
-from proto.telemetry import AgentState, AgentStatus, HumanPose
-from tests.support.processes import free_port, port_open, running, wait_until
+from proto.rpc import (
+    FleetReply,
+    GetFleet,
+    GetMetrics,
+    GetPlans,
+    MetricsReply,
+    PlansReply,
+    UavOpState,
+)
+from proto.telemetry import AgentState, AgentStatus, HumanPose, OutcomeResult, TaskOutcome
+from tests.support.processes import free_port, port_open, running, running_alive, wait_until
 
 ROOT = pathlib.Path(__file__).resolve().parents[2]
 GEN = ROOT / "deploy" / "tls" / "gen-dev-ca.sh"
@@ -283,6 +291,45 @@ def test_plan_resync_query_and_ground_station_token_under_acl(pki, endpoint):
 
     with open_as(pki, endpoint, "gs") as gs, open_as(pki, endpoint, "uav-1") as uav:
         asyncio.run(scenario(gs, uav))
+
+
+def test_a_ground_station_drops_what_uav_2_says_about_uav_1_on_its_own_keys(
+    pki, endpoint, tmp_path
+):
+    """The ACL lets uav-2 publish on its own keys only; what it says there
+    about uav-1 (an emergency, a completed task) the real ground station
+    drops and counts, and uav-1's state does not change."""
+    args = [
+        sys.executable,
+        "-m",
+        "ground_station",
+        "--connect",
+        endpoint,
+        "--zenoh-config",
+        str(pki / "zenoh" / "client-gs.json5"),
+        "--db",
+        str(tmp_path / "gs.db"),
+    ]
+    operator_config = config(endpoint, pki / "zenoh" / "client-operator.json5")
+    token = KEYS.alive(Role.GROUND_STATION, "gs")
+    outcome = TaskOutcome(uav_id="uav-1", task_id="t1", epoch=1, result=OutcomeResult.COMPLETED)
+    emergency = AgentStatus(uav_id="uav-1", stamp_s=time.time(), state=AgentState.EMERGENCY)
+    with (
+        running_alive(args, "secure-gs", operator_config, token),
+        open_as(pki, endpoint, "uav-2") as uav2,
+        open_as(pki, endpoint, "operator") as operator,
+    ):
+
+        def dropped() -> float:
+            uav2.publish(KEYS.outcome("uav-2"), outcome)
+            uav2.publish(KEYS.uav("uav-2", UavTopic.STATUS), emergency)
+            metrics = operator.query(KEYS.rpc("metrics"), GetMetrics(), MetricsReply, 5.0)
+            return metrics.values["bus_identity_mismatch"]
+
+        wait_until(lambda: dropped() >= 2, 20, "the ground station counted uav-2's words")
+        fleet = operator.query(KEYS.rpc("fleet"), GetFleet(), FleetReply, 5.0)
+        uav1 = next(u for u in fleet.uavs if u.uav_id == "uav-1")
+        assert uav1.status is None and uav1.state is not UavOpState.EMERGENCY
 
 
 def test_gateway_reaches_the_ground_station_but_cannot_write_the_fleet(pki, endpoint):
