@@ -15,7 +15,7 @@ from onboard_agent.agent import Agent
 from onboard_agent.autopilot.link import MavlinkLink
 from onboard_agent.comms import Comms
 from onboard_agent.config import AgentConfig
-from proto.geo import LocalFrame
+from proto.geo import SiteFrame
 from proto.keys import KeySpace
 from proto.scenario import Scenario
 
@@ -51,7 +51,7 @@ async def run_agent(
     the bus and the MAVLink link. Keys use ``site`` (default: the scenario's).
     Task durations and plan times run on the mission clock (``speedup``);
     link timeouts on real time. With ``signing_key`` the MAVLink link is signed."""
-    frame = LocalFrame(scenario.site.origin)
+    frame = SiteFrame(scenario.site.origin)
     link = MavlinkLink(autopilot_url, frame, config, signing_key=signing_key)
     agent = Agent(
         uav_id,

@@ -16,7 +16,7 @@ from proto.errors import (
 )
 from proto.events import EventKind, GsEvent
 from proto.fleet import Capability, Fleet, UavSpec, UavType
-from proto.geo import GeoPoint, LocalFrame, Point, Vector
+from proto.geo import GeoPoint, LocalFrame, Point, SiteFrame, Vector
 from proto.keys import KeySpace, ParsedKey, Role, UavTopic, check_id
 from proto.mission import (
     Action,
@@ -195,6 +195,7 @@ __all__ = [
     "SimFault",
     "SimState",
     "Site",
+    "SiteFrame",
     "SpotClaim",
     "StationSpots",
     "SubmitAction",

@@ -35,7 +35,9 @@ class Vector(Record, frozen=True, kw_only=True):
 
 
 class GeoPoint(Record, frozen=True, kw_only=True):
-    """A WGS84 position: degrees, and metres above the ellipsoid."""
+    """A WGS84 position in degrees, and an altitude in metres: above mean sea
+    level (AMSL, MAVLink's datum) in a site origin and wherever
+    :class:`SiteFrame` made it; above the ellipsoid from :class:`LocalFrame`."""
 
     lat_deg: Finite = 0.0
     lon_deg: Finite = 0.0
@@ -63,3 +65,36 @@ class LocalFrame:
             geo.lat_deg, geo.lon_deg, geo.alt_m, o.lat_deg, o.lon_deg, o.alt_m
         )
         return Point(x_m=float(x), y_m=float(y), z_m=float(z))
+
+
+class SiteFrame:
+    """Site-local points <-> WGS84 positions with AMSL altitudes: the one
+    altitude frame of the agent, the simulator and MAVLink.
+
+    x and y are metres east and north of the site origin (ENU on WGS84, by
+    :class:`LocalFrame`); z is the height above the origin's
+    altitude: ``z = alt - origin.alt_m``. MAVLink's absolute altitudes
+    (GLOBAL_POSITION_INT.alt, HOME_POSITION, the GLOBAL(_INT) frames) are AMSL,
+    so z is the height the site's pads, towers and workers are given in,
+    wherever the autopilot last armed (relative altitudes are above that spot).
+
+    The origin's ``alt_m`` must be in the autopilot's datum (AMSL): a site
+    surveyed in ellipsoidal heights converts first. z is not ENU "up", whose
+    plane rises above level ground away from the origin (2 m at 5 km).
+    """
+
+    def __init__(self, origin: GeoPoint) -> None:
+        self.origin = origin
+        self._enu = LocalFrame(origin)
+
+    def to_geodetic(self, point: Point) -> GeoPoint:
+        """Site-local metres -> degrees and AMSL metres."""
+        level = self._enu.to_geodetic(Point(x_m=point.x_m, y_m=point.y_m))
+        alt = self.origin.alt_m + point.z_m
+        return GeoPoint(lat_deg=level.lat_deg, lon_deg=level.lon_deg, alt_m=alt)
+
+    def to_local(self, geo: GeoPoint) -> Point:
+        """Degrees and AMSL metres -> site-local metres."""
+        level = GeoPoint(lat_deg=geo.lat_deg, lon_deg=geo.lon_deg, alt_m=self.origin.alt_m)
+        p = self._enu.to_local(level)
+        return Point(x_m=p.x_m, y_m=p.y_m, z_m=geo.alt_m - self.origin.alt_m)

@@ -137,14 +137,16 @@ def _mode_change(vehicle: Vehicle, mode: Mode) -> Outcome:
 
 
 def takeoff(vehicle: Vehicle, alt_m: float) -> Outcome:
-    """GUIDED takeoff to ``alt_m`` above home (ModeGuided::do_user_takeoff)."""
+    """GUIDED takeoff to ``alt_m`` above home (ModeGuided::do_user_takeoff:
+    refused unless above the current altitude above home)."""
     if vehicle.mode not in TAKEOFF_MODES or not vehicle.armed:
         return FAILED
     if vehicle.state is not FlightState.LANDED or math.isnan(alt_m):
         return FAILED
-    if alt_m <= vehicle.position[2]:
+    home_z = vehicle.home[2]
+    if alt_m <= vehicle.position[2] - home_z:
         return FAILED
-    vehicle.start_takeoff(alt_m)
+    vehicle.start_takeoff(home_z + alt_m)
     return ACCEPTED
 
 
@@ -153,7 +155,7 @@ def change_speed(vehicle: Vehicle, speed_type: int, speed_mps: float) -> Outcome
         return DENIED  # "Target speed must be larger than zero"
     if speed_type not in (0, 1, 2, 3):
         return DENIED
-    if vehicle.mode not in (Mode.GUIDED, Mode.RTL):
+    if vehicle.mode not in (Mode.GUIDED, Mode.RTL, Mode.AUTO):
         return FAILED  # the mode has no speed to set
     t = vehicle.type
     if speed_type in (0, 1):

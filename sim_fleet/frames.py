@@ -1,8 +1,9 @@
 """MAVLink coordinate frames -> site ENU, for position and velocity targets.
 
 Local NED frames are relative to the vehicle's EKF origin, which (as in SITL)
-is where it was powered on: its home pad. The ground is flat, so relative and
-terrain altitudes are both height above the home pad.
+is where it was powered on: its home pad. GLOBAL(_INT) altitudes are AMSL;
+relative altitudes are above home (the endpoint adds home's height). There
+is no terrain database, so terrain altitudes are taken as relative too.
 """
 
 from __future__ import annotations

@@ -23,6 +23,10 @@ endpoint, shared by every datagram's parser).
 Peers: a learned peer heard within ``PEER_LIVE_S`` keeps its place, so a
 flood of strangers cannot push the agent out of the table; a newcomer finds
 room only when a peer has gone quiet (counted in ``refused_peers``).
+
+Telemetry messages are built by ``mavlink_telemetry``, the mission protocol
+is ``mavlink_missions`` and AUTO's execution ``auto_mission`` (advanced from
+``tick``); all of them use this module's encoder.
 """
 
 from __future__ import annotations
@@ -38,9 +42,11 @@ os.environ["MAVLINK20"] = "1"  # for any mavutil user in this process; we use th
 from pymavlink.dialects.v20 import ardupilotmega as mav
 
 from linecrew.mavlink_keys import signing_timestamp
-from sim_fleet import autopilot, frames, streams
+from sim_fleet import autopilot, frames, mavlink_telemetry, streams
+from sim_fleet.auto_mission import AutoMission
 from sim_fleet.events import Outcome, Result, Severity
-from sim_fleet.modes import LANDED_STATE, base_mode, system_status
+from sim_fleet.mavlink_missions import MissionProtocol
+from sim_fleet.modes import FLAG_CUSTOM_MODE_ENABLED, Mode
 from sim_fleet.vehicle import Vehicle
 from sim_fleet.world import World
 
@@ -51,23 +57,20 @@ MAX_LEARNED_PEERS = 8
 PEER_LIVE_S = 5.0  # a peer heard this recently is never displaced by a newcomer
 POS_IGNORE = 0b111
 VEL_IGNORE = 0b111000
-# AUTOPILOT_VERSION: ArduCopter 4.5.0 official
-FLIGHT_SW_VERSION = (4 << 24) | (5 << 16) | (0 << 8) | 255
-CAPABILITIES = (
-    mav.MAV_PROTOCOL_CAPABILITY_COMMAND_INT
-    | mav.MAV_PROTOCOL_CAPABILITY_SET_POSITION_TARGET_LOCAL_NED
-    | mav.MAV_PROTOCOL_CAPABILITY_SET_POSITION_TARGET_GLOBAL_INT
-    | mav.MAV_PROTOCOL_CAPABILITY_MAVLINK2
+
+MISSION_MESSAGES = frozenset(
+    {
+        "MISSION_COUNT",
+        "MISSION_ITEM_INT",
+        "MISSION_ITEM",
+        "MISSION_REQUEST_LIST",
+        "MISSION_REQUEST_INT",
+        "MISSION_REQUEST",
+        "MISSION_CLEAR_ALL",
+        "MISSION_SET_CURRENT",
+        "MISSION_ACK",
+    }
 )
-SENSOR_GPS = 0x20
-SENSOR_AHRS = 0x200000
-SENSOR_BATTERY = 0x2000000
-SENSOR_PREARM = 0x10000000  # MAV_SYS_STATUS_PREARM_CHECK: healthy when armable
-SENSORS = 0x1 | 0x2 | 0x4 | 0x8 | SENSOR_GPS | 0x8000 | SENSOR_AHRS | SENSOR_BATTERY | SENSOR_PREARM
-# EKF_STATUS_REPORT flags: attitude, velocities, positions (rel/abs, horiz/vert), predicted
-EKF_GOOD = 0x1 | 0x2 | 0x4 | 0x8 | 0x10 | 0x20 | 0x100 | 0x200
-EKF_NO_GPS = 0x1 | 0x4 | 0x80  # attitude, vertical velocity, constant position mode
-UINT16_MAX = 65535
 
 Addr = tuple[str, int]
 
@@ -98,6 +101,8 @@ class VehicleEndpoint(asyncio.DatagramProtocol):
             sign.secret_key, sign.sign_outgoing = signing_key, True
             sign.timestamp = signing_timestamp()
         self._home_sent = 0  # the vehicle's home_version last broadcast
+        self.auto = AutoMission(world, vehicle)
+        self.missions = MissionProtocol(self._mav, self._send_to, self.auto)
         self._transport: asyncio.DatagramTransport | None = None
 
     # ---- asyncio protocol ------------------------------------------------
@@ -184,7 +189,7 @@ class VehicleEndpoint(asyncio.DatagramProtocol):
                 )
                 self._command(autopilot.Command(msg.command, p, msg.frame), msg, addr)
             case "SET_MODE" if msg.target_system == self.vehicle.sysid:
-                outcome = autopilot.set_mode(self.vehicle, msg.base_mode, msg.custom_mode)
+                outcome = self._set_mode(msg.base_mode, msg.custom_mode)
                 self._ack(mav.MAVLINK_MSG_ID_SET_MODE, outcome, msg, addr)
             case "SET_POSITION_TARGET_GLOBAL_INT" if self._for_me(msg):
                 self._global_target(msg)
@@ -193,6 +198,8 @@ class VehicleEndpoint(asyncio.DatagramProtocol):
             case "REQUEST_DATA_STREAM" if self._for_me(msg):
                 rate = float(msg.req_message_rate)
                 self.schedule.request_data_stream(msg.req_stream_id, rate, bool(msg.start_stop))
+            case kind if kind in MISSION_MESSAGES and self._for_me(msg):
+                self.missions.handle(msg, addr)
             case "PARAM_REQUEST_LIST" if self._for_me(msg):
                 for param in self.vehicle.parameters.all():
                     self._send_to([addr], self._param_value(param.name))
@@ -233,6 +240,12 @@ class VehicleEndpoint(asyncio.DatagramProtocol):
                 outcome = autopilot.reposition(
                     self.vehicle, self._reposition_target(cmd), autopilot.as_int(p[1])
                 )
+            case mav.MAV_CMD_DO_SET_MODE:
+                outcome = self._set_mode(autopilot.as_int(p[0]), autopilot.as_int(p[1]))
+            case mav.MAV_CMD_MISSION_START:
+                outcome = self.auto.start_command()
+            case mav.MAV_CMD_DO_SET_MISSION_CURRENT:
+                outcome = self.missions.do_set_current(p[0], p[1])
             case _:
                 outcome = autopilot.handle_command(cmd, self.vehicle, self.world)
         self._ack(cmd.command, outcome, msg, addr)
@@ -246,6 +259,12 @@ class VehicleEndpoint(asyncio.DatagramProtocol):
                 self._send_to([addr], self._encode(autopilot.as_int(p[0])))
             case mav.MAV_CMD_REQUEST_AUTOPILOT_CAPABILITIES:
                 self._send_to([addr], self._encode(streams.AUTOPILOT_VERSION))
+
+    def _set_mode(self, base: int, custom: int) -> Outcome:
+        """SET_MODE / DO_SET_MODE; AUTO is entered by the mission (``auto_mission``)."""
+        if custom == Mode.AUTO and base >= 0 and base & FLAG_CUSTOM_MODE_ENABLED:
+            return self.auto.enter()
+        return autopilot.set_mode(self.vehicle, base, custom)
 
     def _reposition_target(self, cmd: autopilot.Command) -> tuple[float, float, float] | None:
         """DO_REPOSITION's location in ENU; NaN / 0 lat-lon or altitude keep the current one."""
@@ -314,15 +333,21 @@ class VehicleEndpoint(asyncio.DatagramProtocol):
 
     # ---- outgoing --------------------------------------------------------
     def tick(self) -> None:
-        """Send due telemetry and pending STATUSTEXTs; called after each world step."""
+        """Advance the mission; send due telemetry, pending STATUSTEXTs and mission
+        progress; called after each world step."""
+        self.auto.update()
         texts = self.vehicle.take_texts()
+        progress = self.missions.outgoing()
         if not self.vehicle.link_up() or self._transport is None:
             return
+        self.missions.tick()
         peers = [*self.static_peers, *self.peers]
         if not peers:
             return
         for t in texts:
             self._send_to(peers, self._statustext(int(t.severity), t.text))
+        for msg in progress:
+            self._send_to(peers, msg)
         if self.vehicle.home_set and self.vehicle.home_version != self._home_sent:
             self._home_sent = self.vehicle.home_version  # ArduPilot announces a new home
             self._send_to(peers, self._encode(streams.HOME_POSITION))
@@ -355,111 +380,6 @@ class VehicleEndpoint(asyncio.DatagramProtocol):
 
     def _encode(self, msg_id: int) -> Any:
         """Build one telemetry message from the vehicle's state (None if unknown)."""
-        v, m = self.vehicle, self._mav
-        boot_ms = int(self.world.time_s * 1000) & 0xFFFFFFFF
-        pos, vel = v.reported_position()
-        battery = v.battery
-        pct = max(0, min(100, round(battery.soc * 100)))
-        match msg_id:
-            case streams.HEARTBEAT:
-                critical = battery.soc <= v.params.critical_soc
-                return m.heartbeat_encode(
-                    mav.MAV_TYPE_QUADROTOR,
-                    mav.MAV_AUTOPILOT_ARDUPILOTMEGA,
-                    base_mode(v.mode, v.armed),
-                    int(v.mode),
-                    system_status(v.armed, v.state, critical),
-                )
-            case streams.GLOBAL_POSITION_INT:
-                if not v.ekf_ok:  # no position yet: ArduCopter sends zeros
-                    return m.global_position_int_encode(boot_ms, 0, 0, 0, 0, 0, 0, 0, UINT16_MAX)
-                lat, lon, alt = self.world.geo.to_geodetic(pos)
-                return m.global_position_int_encode(
-                    boot_ms, round(lat * 1e7), round(lon * 1e7), round(alt * 1000),
-                    round((pos[2] - v.home[2]) * 1000), round(vel[1] * 100), round(vel[0] * 100),
-                    round(-vel[2] * 100), round(v.heading_deg * 100) % 36000,
-                )  # fmt: skip
-            case streams.GPS_RAW_INT:
-                if not v.gps_fix:
-                    return m.gps_raw_int_encode(
-                        boot_ms * 1000, 1, 0, 0, 0, UINT16_MAX, UINT16_MAX, 0, UINT16_MAX, 0
-                    )  # fix_type 1: NO_FIX
-                lat, lon, alt = self.world.geo.to_geodetic(pos)
-                cog = round(v.heading_deg * 100) % 36000
-                return m.gps_raw_int_encode(
-                    boot_ms * 1000, 3, round(lat * 1e7), round(lon * 1e7), round(alt * 1000),
-                    121, 200, round(math.hypot(vel[0], vel[1]) * 100), cog, 10,
-                )  # fmt: skip
-            case streams.EKF_STATUS_REPORT:
-                if v.ekf_ok:
-                    return m.ekf_status_report_encode(EKF_GOOD, 0.02, 0.01, 0.01, 0.02, 0.0)
-                return m.ekf_status_report_encode(EKF_NO_GPS, 0.0, 0.0, 0.0, 0.02, 0.0)
-            case streams.ATTITUDE:
-                yaw = math.radians(v.heading_deg)
-                yaw = yaw - 2 * math.pi if yaw > math.pi else yaw
-                return m.attitude_encode(boot_ms, 0.0, 0.0, yaw, 0.0, 0.0, 0.0)
-            case streams.VFR_HUD:
-                _, _, alt = self.world.geo.to_geodetic(pos if v.ekf_ok else (0.0, 0.0, 0.0))
-                gs = math.hypot(vel[0], vel[1])
-                throttle = 50 if v.armed and v.airborne else 0
-                return m.vfr_hud_encode(gs, gs, round(v.heading_deg) % 360, throttle, alt, vel[2])
-            case streams.SYS_STATUS:
-                health = SENSORS
-                if battery.soc <= v.params.critical_soc:
-                    health &= ~SENSOR_BATTERY
-                if not v.gps_fix:
-                    health &= ~SENSOR_GPS
-                if not v.ekf_ok:
-                    health &= ~SENSOR_AHRS
-                if v.prearm_failures():
-                    health &= ~SENSOR_PREARM
-                return m.sys_status_encode(
-                    SENSORS, SENSORS, health, 0, round(battery.voltage_v() * 1000),
-                    round(battery.current_a() * 100), pct, 0, 0, 0, 0, 0, 0,
-                )  # fmt: skip
-            case streams.BATTERY_STATUS:
-                return self._battery_status(pct)
-            case streams.EXTENDED_SYS_STATE:
-                return m.extended_sys_state_encode(0, LANDED_STATE[v.state])
-            case streams.HOME_POSITION:
-                if not v.home_set:
-                    return None  # ArduPilot sends no HOME_POSITION before home is set
-                lat, lon, alt = self.world.geo.to_geodetic(v.home)
-                return m.home_position_encode(
-                    round(lat * 1e7), round(lon * 1e7), round(alt * 1000), 0.0, 0.0, 0.0,
-                    [1.0, 0.0, 0.0, 0.0], 0.0, 0.0, 0.0, boot_ms * 1000,
-                )  # fmt: skip
-            case streams.AUTOPILOT_VERSION:
-                zeros = [0] * 8
-                return m.autopilot_version_encode(
-                    CAPABILITIES, FLIGHT_SW_VERSION, 0, 0, 0, zeros, zeros, zeros, 0, 0, v.sysid
-                )
-        return None
-
-    def _battery_status(self, pct: int) -> Any:
-        v = self.vehicle
-        b = v.battery
-        docked = self.world.station_status(v.id)
-        if docked is not None and docked[1] == "charging":
-            charge_state = mav.MAV_BATTERY_CHARGE_STATE_CHARGING
-        elif b.soc <= v.params.critical_soc:
-            charge_state = mav.MAV_BATTERY_CHARGE_STATE_CRITICAL
-        elif b.soc <= v.params.low_soc:
-            charge_state = mav.MAV_BATTERY_CHARGE_STATE_LOW
-        else:
-            charge_state = mav.MAV_BATTERY_CHARGE_STATE_OK
-        remaining_s = round(b.energy_wh * 3600 / b.load_w) if b.load_w > 0 else 0
-        voltages = [min(round(b.voltage_v() * 1000), UINT16_MAX - 1)] + [UINT16_MAX] * 9
-        return self._mav.battery_status_encode(
-            0,
-            mav.MAV_BATTERY_FUNCTION_ALL,
-            mav.MAV_BATTERY_TYPE_LIPO,
-            32767,  # temperature unknown (INT16_MAX)
-            voltages,
-            round(b.current_a() * 100),  # cA
-            round(b.consumed_mah()),  # mAh
-            round(b.consumed_wh * 36),  # hJ
-            pct,
-            remaining_s,
-            charge_state,
-        )
+        if msg_id == streams.MISSION_CURRENT:
+            return self.missions.mission_current()
+        return mavlink_telemetry.encode(self._mav, self.world, self.vehicle, msg_id)

@@ -13,6 +13,7 @@ class Mode(IntEnum):
     """ArduCopter custom_mode numbers the simulator implements."""
 
     STABILIZE = 0  # no sticks here: holds position in the air, armable on ground
+    AUTO = 3  # flies the uploaded mission (auto_mission); not armable (AUTO_OPTIONS 0)
     GUIDED = 4
     LOITER = 5  # no sticks here: holds position
     RTL = 6
@@ -56,7 +57,7 @@ STATE_ACTIVE = 4
 STATE_CRITICAL = 5
 STATE_EMERGENCY = 6
 
-_GUIDED_LIKE = frozenset({Mode.GUIDED, Mode.RTL})
+_GUIDED_LIKE = frozenset({Mode.GUIDED, Mode.RTL, Mode.AUTO})
 
 
 def base_mode(mode: Mode, armed: bool) -> int:

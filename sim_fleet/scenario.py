@@ -5,8 +5,10 @@ These are stand-ins until the shared site/fleet description lands in
 use plain names with units, so swapping them for the proto types is a matter
 of one adapter function (``Scenario`` <- proto site + fleet).
 
-Geometry is local ENU metres ``(east, north, up)`` around ``origin``; the
-ground is flat at ``up == 0``.
+Geometry is site metres ``(east, north, up)`` around ``origin``, up being
+the height above the origin's altitude (:mod:`linecrew.site_frame`); the
+terrain is flat at ``up == 0`` and a station whose position has ``up > 0``
+stands that high (a deck on a roof: see :mod:`sim_fleet.terrain`).
 """
 
 from __future__ import annotations

@@ -23,6 +23,7 @@ SYS_STATUS = 1
 GPS_RAW_INT = 24
 ATTITUDE = 30
 GLOBAL_POSITION_INT = 33
+MISSION_CURRENT = 42
 VFR_HUD = 74
 AUTOPILOT_VERSION = 148
 BATTERY_STATUS = 147
@@ -42,6 +43,7 @@ STREAMABLE = frozenset(
         HOME_POSITION,
         GPS_RAW_INT,
         EKF_STATUS_REPORT,
+        MISSION_CURRENT,
     }
 )
 REQUESTABLE = STREAMABLE | {AUTOPILOT_VERSION}
@@ -49,7 +51,7 @@ REQUESTABLE = STREAMABLE | {AUTOPILOT_VERSION}
 # MAV_DATA_STREAM groups as ArduCopter fills them (GCS_MAVLink_Copter.cpp)
 STREAM_ALL = 0
 DATA_STREAMS = {
-    2: (SYS_STATUS, GPS_RAW_INT, EXTENDED_SYS_STATE),  # EXTENDED_STATUS
+    2: (SYS_STATUS, GPS_RAW_INT, EXTENDED_SYS_STATE, MISSION_CURRENT),  # EXTENDED_STATUS
     6: (GLOBAL_POSITION_INT,),  # POSITION
     10: (ATTITUDE,),  # EXTRA1
     11: (VFR_HUD,),  # EXTRA2
@@ -64,7 +66,7 @@ class TelemetryRates:
     heartbeat_hz: float = 1.0
     position_hz: float = 5.0  # GLOBAL_POSITION_INT
     attitude_hz: float = 2.0  # ATTITUDE and VFR_HUD
-    status_hz: float = 1.0  # SYS_STATUS, BATTERY_STATUS, EXTENDED_SYS_STATE, GPS, EKF
+    status_hz: float = 1.0  # SYS_STATUS, BATTERY_STATUS, EXT_SYS_STATE, GPS, EKF, MISSION_CURRENT
     stream_by_default: bool = False  # stream the rates above before anyone asks
 
     def intervals_s(self) -> dict[int, float]:
@@ -81,6 +83,7 @@ class TelemetryRates:
             EXTENDED_SYS_STATE: iv(self.status_hz),
             GPS_RAW_INT: iv(self.status_hz),
             EKF_STATUS_REPORT: iv(self.status_hz),
+            MISSION_CURRENT: iv(self.status_hz),
         }
 
 

@@ -7,7 +7,7 @@ import asyncio
 import time
 
 from linecrew.bus import Bus
-from proto.geo import LocalFrame, Point
+from proto.geo import Point, SiteFrame
 from proto.keys import KeySpace
 from proto.site import Site
 from proto.telemetry import HumanPose
@@ -23,7 +23,7 @@ class HumanTracker:
         self.world = world
         self.bus = bus
         self.keys = KeySpace(site.id)
-        self.frame = LocalFrame(site.origin)
+        self.frame = SiteFrame(site.origin)
 
     def publish_once(self) -> None:
         """Move scripted workers along their paths, and publish every pose

@@ -9,14 +9,16 @@ from __future__ import annotations
 
 import logging
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
 
 from sim_fleet import physics
 from sim_fleet.battery import Battery
 from sim_fleet.events import Severity, StatusText
 from sim_fleet.modes import FlightState, Mode
-from sim_fleet.params import INT8, INT16, INT32, REAL32, Param, ParamStore
+from sim_fleet.params import ParamStore, vehicle_parameters
 from sim_fleet.scenario import ToolSpec, Vec3, VehicleSpec, VehicleType
+from sim_fleet.terrain import flat
 
 log = logging.getLogger(__name__)
 
@@ -56,13 +58,15 @@ class Vehicle:
         sysid: int,
         home: Vec3,
         params: AutopilotParams | None = None,
+        ground: Callable[[float, float], float] = flat,
     ) -> None:
         self.id = spec.id
         self.spec = spec
         self.type = vtype
         self.sysid = sysid
         self.params = params or AutopilotParams()
-        self.home: Vec3 = (home[0], home[1], 0.0)
+        self.ground = ground  # the ground's height under (x, y): a deck's top, else terrain
+        self.home: Vec3 = (home[0], home[1], ground(home[0], home[1]))
         self.origin: Vec3 = self.home  # EKF origin (LOCAL_NED frames): the power-on spot
         self.home_set = self.params.warmup_s <= 0
         self.home_version = 0  # bumped when home is set or moved (HOME_POSITION goes out)
@@ -94,7 +98,7 @@ class Vehicle:
         self.link_down_until = 0.0
         self.gps_frozen: tuple[Vec3, Vec3] | None = None
         self.gps_frozen_until = math.inf
-        self.parameters = ParamStore(default_parameters(self))
+        self.parameters = ParamStore(vehicle_parameters(sysid, vtype, self.params))
 
     # ---- status ----------------------------------------------------------
     @property
@@ -138,6 +142,10 @@ class Vehicle:
     @property
     def rtl_alt_m(self) -> float:
         return self.parameters.get("RTL_ALT") / 100.0
+
+    def ground_z(self) -> float:
+        """The ground's height under the vehicle (a raised deck's top, else terrain)."""
+        return self.ground(self.position[0], self.position[1])
 
     def say(self, severity: Severity, text: str) -> None:
         log.info("%s: %s", self.id, text, extra={"uav_id": self.id})
@@ -190,22 +198,24 @@ class Vehicle:
             return
         if mode is Mode.LAND:
             self.state = FlightState.LANDING
-            self._land_at = (self.position[0], self.position[1], 0.0)
+            self._land_at = (self.position[0], self.position[1], self.ground_z())
         elif mode is Mode.RTL:
             self.state = FlightState.FLYING
             self.rtl_phase = "climb"
-            self._rtl_alt_m = max(self.position[2], self.rtl_alt_m)
+            self._rtl_alt_m = max(self.position[2], self.home[2] + self.rtl_alt_m)
         else:
             self.state = FlightState.FLYING
             self.target = self.position  # GUIDED/STABILIZE entry: hold here
 
-    def start_takeoff(self, alt_m: float) -> None:
+    def start_takeoff(self, z_m: float) -> None:
+        """Climb straight up to the site height ``z_m``."""
         self.state = FlightState.TAKING_OFF
-        self.target = (self.position[0], self.position[1], alt_m)
+        self.target = (self.position[0], self.position[1], z_m)
 
     def fly_to(self, target: Vec3) -> None:
         self.velocity_cmd = None
-        self.target = (target[0], target[1], max(0.0, target[2]))
+        x, y, z = target
+        self.target = (x, y, max(self.ground(x, y), z))
         if self.state is FlightState.TAKING_OFF:
             self.state = FlightState.FLYING
 
@@ -249,7 +259,7 @@ class Vehicle:
         if self.state is FlightState.FALLING:
             self.position, self.velocity = physics.step_falling(self.position, self.velocity, dt_s)
             self.battery.load_w = 0.0
-            if self.position[2] <= 0.0:
+            if self.position[2] <= self.ground_z():
                 self._crash()
             return
         if self.state in (FlightState.LANDED, FlightState.CRASHED):
@@ -302,17 +312,17 @@ class Vehicle:
             if self.state is FlightState.TAKING_OFF and self.position == target:
                 self.state = FlightState.FLYING
         self._update_heading()
-        if self.position[2] <= 0.0 and self.state is FlightState.FLYING:
-            self._crash()  # flown into the ground: only LAND and RTL touch down
+        if self.position[2] <= self.ground_z() and self.state is FlightState.FLYING:
+            self._crash()  # flown into the ground (or a deck): only LAND and RTL touch down
 
     def _descend(self, dt_s: float) -> None:
-        final = self.position[2] <= self.params.land_final_alt_m
+        ground_z = self.ground_z()
+        final = self.position[2] - ground_z <= self.params.land_final_alt_m
         down = min(self.type.land_speed_mps, self.descent_mps) if final else self.descent_mps
-        ground = self._land_at
         self.position, self.velocity = physics.step_to_target(
-            self.position, self.velocity, ground, self.limits(down_mps=down), dt_s
+            self.position, self.velocity, self._land_at, self.limits(down_mps=down), dt_s
         )
-        if self.position[2] <= 1e-3:
+        if self.position[2] <= ground_z + 1e-3:
             self._touchdown()
 
     def _rtl(self, dt_s: float) -> None:
@@ -328,7 +338,7 @@ class Vehicle:
             if physics.horizontal_distance(self.position, self.home) < 1e-2:
                 self.rtl_phase = "descend"
                 self.state = FlightState.LANDING
-                self._land_at = self.home
+                self._land_at = (hx, hy, self.ground(hx, hy))  # down to home's ground
                 return
         self.position, self.velocity = physics.step_to_target(
             self.position, self.velocity, goal, self.limits(), dt_s
@@ -349,7 +359,7 @@ class Vehicle:
         self.say(Severity.INFO, "EKF3 IMU0 origin set")
 
     def _touchdown(self) -> None:
-        self.position = (self.position[0], self.position[1], 0.0)
+        self.position = (self.position[0], self.position[1], self.ground_z())
         self.velocity = (0.0, 0.0, 0.0)
         self.state = FlightState.LANDED
         self.target = None
@@ -367,7 +377,7 @@ class Vehicle:
         self.battery.load_w = 0.0
 
     def _crash(self) -> None:
-        self.position = (self.position[0], self.position[1], 0.0)
+        self.position = (self.position[0], self.position[1], self.ground_z())
         self.velocity = (0.0, 0.0, 0.0)
         self.state = FlightState.CRASHED
         self.target = None
@@ -387,24 +397,3 @@ class Vehicle:
                 f"{self.battery.consumed_mah():.0f} mAh",
             )
         self._warned = max(self._warned, level)
-
-
-def default_parameters(v: Vehicle) -> list[Param]:
-    """The vehicle's parameter file: ArduCopter names and units."""
-    t, p = v.type, v.params
-    cells_v = 3.7 * t.cells
-    return [
-        Param("SYSID_THISMAV", float(v.sysid), INT16, read_only=True),
-        Param("FRAME_CLASS", 1.0, INT8, read_only=True),  # quad
-        Param("ARMING_CHECK", 1.0, INT32),
-        Param("DISARM_DELAY", float(p.auto_disarm_s or 0), INT8),
-        Param("GRIP_ENABLE", 1.0 if t.gripper else 0.0, INT8),
-        Param("RTL_ALT", round(p.rtl_alt_m * 100), INT32),
-        Param("LAND_SPEED", round(t.land_speed_mps * 100), INT16),
-        Param("WPNAV_SPEED", t.cruise_speed_mps * 100, REAL32),
-        Param("WPNAV_SPEED_UP", t.climb_rate_mps * 100, REAL32),
-        Param("WPNAV_SPEED_DN", t.descent_rate_mps * 100, REAL32),
-        Param("BATT_CAPACITY", float(round(t.battery_wh / cells_v * 1000)), INT32, read_only=True),
-        Param("BATT_ARM_MAH", 0.0, INT32),
-        Param("SIM_WARMUP_S", p.warmup_s, REAL32, read_only=True),  # not ArduCopter's: the sim's
-    ]

@@ -22,6 +22,7 @@ from sim_fleet.modes import FlightState
 from sim_fleet.safety import SafetyMonitor, Violation
 from sim_fleet.scenario import Scenario, Vec3
 from sim_fleet.stations import ChargingStation
+from sim_fleet.terrain import Ground
 from sim_fleet.tools import Delivery, Drop, ToolStation, station_in_reach, worker_in_reach
 from sim_fleet.vehicle import AutopilotParams, Vehicle
 from sim_fleet.watch import WatchLog
@@ -44,6 +45,7 @@ class World:
         self.physics_step_s = physics_step_s
         self.time_s = 0.0
         self._pending_s = 0.0
+        self.ground = Ground(scenario.stations, self.rules.dock_radius_m)
         self.vehicles: dict[str, Vehicle] = {}
         placed: dict[str, int] = {}  # UAVs put on each station's spots so far
         for i, spec in enumerate(scenario.vehicles):
@@ -51,7 +53,12 @@ class World:
             n = placed[spec.home_station] = placed.get(spec.home_station, 0) + 1
             home = spots[(n - 1) % len(spots)]
             self.vehicles[spec.id] = Vehicle(
-                spec, scenario.types[spec.type], sysid=first_sysid + i, home=home, params=params
+                spec,
+                scenario.types[spec.type],
+                sysid=first_sysid + i,
+                home=home,
+                params=params,
+                ground=self.ground.z_at,
             )
         self.charging = {
             s.id: ChargingStation(s) for s in scenario.stations if s.recharge is not None
@@ -71,6 +78,10 @@ class World:
 
     def vehicle(self, vehicle_id: str) -> Vehicle:
         return self.vehicles[vehicle_id]
+
+    def ground_z(self, x: float, y: float) -> float:
+        """The ground's height at (x, y): a station deck's top, else the terrain."""
+        return self.ground.z_at(x, y)
 
     # ---- time -------------------------------------------------------------
     def step(self, dt_s: float) -> None:

@@ -10,6 +10,12 @@ Position targets (SET_POSITION_TARGET_GLOBAL_INT) have no ACK in MAVLink, so
 callers repeat them. A silent autopilot (no HEARTBEAT for
 ``heartbeat_timeout_s``) shows as ``state.link_ok == False``.
 
+One altitude frame (:mod:`linecrew.site_frame`): positions are site-local,
+z the height above the site origin, read from the AMSL altitude
+(GLOBAL_POSITION_INT.alt, never relative_alt: ArduCopter re-homes at every
+arming, so "relative" means above wherever it last armed); targets go out
+AMSL (MAV_FRAME_GLOBAL_INT). Only NAV_TAKEOFF takes an altitude above home.
+
 ArduCopter streams only what it is asked for (``SRx_`` rates may be 0): on
 finding the autopilot, and again after a heartbeat loss or when positions
 stop while heartbeats go on, the link asks for its telemetry by stream group
@@ -46,7 +52,7 @@ from linecrew.mavlink_keys import signing_timestamp
 from onboard_agent.autopilot.errors import CommandDenied, CommandTimeout, LinkLost
 from onboard_agent.autopilot.protocol import VehicleState
 from onboard_agent.config import AgentConfig
-from proto.geo import GeoPoint, LocalFrame, Point, Vector
+from proto.geo import GeoPoint, Point, SiteFrame, Vector
 from proto.telemetry import FlightState
 
 log = logging.getLogger(__name__)
@@ -100,7 +106,7 @@ class MavlinkLink:
     def __init__(
         self,
         url: str,
-        frame: LocalFrame,
+        frame: SiteFrame,
         config: AgentConfig,
         *,
         clock: Callable[[], float] = time.monotonic,
@@ -194,9 +200,13 @@ class MavlinkLink:
     def disarm(self) -> asyncio.Task[None]:
         return self._spawn(self._command("disarm", mav.MAV_CMD_COMPONENT_ARM_DISARM, 0))
 
-    def takeoff(self, alt_m: float) -> asyncio.Task[None]:
+    def takeoff(self, z_m: float) -> asyncio.Task[None]:
+        """Climb to the site height ``z_m``. NAV_TAKEOFF is above home, which
+        ArduCopter sets where it arms (the new HOME_POSITION may still be on
+        its way): above where the vehicle stands."""
+        above = z_m - self._state.position.z_m
         return self._spawn(
-            self._command("takeoff", mav.MAV_CMD_NAV_TAKEOFF, 0, 0, 0, 0, 0, 0, alt_m)
+            self._command("takeoff", mav.MAV_CMD_NAV_TAKEOFF, 0, 0, 0, 0, 0, 0, above)
         )
 
     def land(self) -> asyncio.Task[None]:
@@ -214,30 +224,17 @@ class MavlinkLink:
         return self._spawn(self._command("speed", mav.MAV_CMD_DO_CHANGE_SPEED, 1, speed_mps, -1))
 
     def goto(self, target: Point) -> asyncio.Task[None]:
-        """Send a position target (relative altitude = local z); no ACK exists."""
+        """Send a position target (AMSL altitude from the site z); no ACK exists."""
         return self._spawn(self._goto(target))
 
     async def _goto(self, target: Point) -> None:
         system, component = await self._wait_target()
         geo = self.frame.to_geodetic(target)
         self._conn.mav.set_position_target_global_int_send(
-            0,
-            system,
-            component,
-            mav.MAV_FRAME_GLOBAL_RELATIVE_ALT_INT,
-            POSITION_ONLY,
-            round(geo.lat_deg * 1e7),
-            round(geo.lon_deg * 1e7),
-            target.z_m,
-            0,
-            0,
-            0,
-            0,
-            0,
-            0,
-            0,
-            0,
-        )
+            0, system, component, mav.MAV_FRAME_GLOBAL_INT, POSITION_ONLY,
+            round(geo.lat_deg * 1e7), round(geo.lon_deg * 1e7), geo.alt_m,
+            0, 0, 0, 0, 0, 0, 0, 0,  # velocity, acceleration, yaw, yaw rate: ignored
+        )  # fmt: skip
 
     async def _command(self, name: str, command: int, *params: float) -> None:
         system, component = await self._wait_target()
@@ -354,8 +351,7 @@ class MavlinkLink:
                     self._state = dataclasses.replace(s, known=False)
                     return
                 geo = GeoPoint(lat_deg=msg.lat / 1e7, lon_deg=msg.lon / 1e7, alt_m=msg.alt / 1000)
-                local = self.frame.to_local(geo)
-                position = Point(x_m=local.x_m, y_m=local.y_m, z_m=msg.relative_alt / 1000)
+                position = self.frame.to_local(geo)
                 velocity = Vector(
                     east_mps=msg.vy / 100, north_mps=msg.vx / 100, up_mps=-msg.vz / 100
                 )

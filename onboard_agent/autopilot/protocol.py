@@ -43,7 +43,9 @@ EKF_CONST_POS_MODE = 0x80  # no absolute position: the EKF holds a constant posi
 
 @dataclasses.dataclass(frozen=True, kw_only=True)
 class VehicleState:
-    """The autopilot's latest report, in the site's local frame.
+    """The autopilot's latest report, in the site's local frame (z: height
+    above the site origin, whatever the autopilot's home; see
+    :mod:`linecrew.site_frame`).
 
     Readiness (can it arm?) comes from what ArduCopter reports before arming:
     GPS_RAW_INT's fix, EKF_STATUS_REPORT's flags, HOME_POSITION and the
@@ -119,7 +121,9 @@ class Autopilot(Protocol):
 
     def arm(self) -> Pending: ...
 
-    def takeoff(self, alt_m: float) -> Pending: ...
+    def takeoff(self, z_m: float) -> Pending:
+        """Climb straight up to the site height ``z_m``."""
+        ...
 
     def goto(self, target: Point) -> Pending: ...
 

@@ -20,7 +20,8 @@ class GoNear(AgentBehaviour):
 
     On the ground: wait until the autopilot reports it can arm (GPS fix, EKF,
     home, pre-arm checks; at most ``ready_timeout_s``), then GUIDED, arm,
-    take off to ``takeoff_alt_m``, each command acknowledged before the next.
+    take off ``takeoff_alt_m`` above the pad it stands on (a roof pad too),
+    each command acknowledged before the next.
     In the air: GUIDED if needed, then the position target (or, where the
     straight line passes near a person, the next leg round them: see
     :mod:`onboard_agent.route`), re-sent every ``goto_resend_s`` and
@@ -44,6 +45,7 @@ class GoNear(AgentBehaviour):
         self._sent: Point | None = None
         self._sent_at = 0.0
         self._takeoff_at = 0.0
+        self._climb_to: float | None = None  # site z of the last takeoff
         self._refusals = 0
         self._retry_at = -1e18
         self._refused = ""
@@ -137,7 +139,8 @@ class GoNear(AgentBehaviour):
             self.command.issue("arm", autopilot.arm())
             self.feedback_message = "arming"
         else:
-            self.command.issue("takeoff", autopilot.takeoff(ctx.config.takeoff_alt_m))
+            self._climb_to = vehicle.position.z_m + ctx.config.takeoff_alt_m
+            self.command.issue("takeoff", autopilot.takeoff(self._climb_to))
             self._takeoff_at = ctx.clock()
             self.feedback_message = "taking off"
         return Status.RUNNING
@@ -145,8 +148,8 @@ class GoNear(AgentBehaviour):
     def _fly(self, point: Point) -> Status:
         ctx, vehicle = self.ctx, self.ctx.vehicle
         config = ctx.config
-        climbing = vehicle.flight_state is FlightState.TAKING_OFF
-        if climbing and vehicle.position.z_m < 0.9 * config.takeoff_alt_m:
+        climb_to = self._climb_to if vehicle.flight_state is FlightState.TAKING_OFF else None
+        if climb_to is not None and vehicle.position.z_m < climb_to - 0.1 * config.takeoff_alt_m:
             self.feedback_message = "climbing"
             return Status.RUNNING
         if vehicle.mode != GUIDED and "guided" not in self._done:

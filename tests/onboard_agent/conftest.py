@@ -1,20 +1,27 @@
-"""Integration fixtures: a sim_fleet vehicle over real MAVLink, the agent as
-a real process, and a test-owned "ground station" on the real router."""
+"""Integration fixtures: a sim_fleet vehicle over real MAVLink (and a link
+flying it in-process), the agent as a real process, and a test-owned
+"ground station" on the real router."""
 
 from __future__ import annotations
 
+import asyncio
 import sys
 import threading
+import time
 
 import msgspec
 import pytest
 
 from linecrew.bus import Bus
 from linecrew.scenarios import load
+from onboard_agent import AgentConfig
+from onboard_agent.autopilot.link import MavlinkLink
+from proto.geo import SiteFrame
 from proto.keys import KeySpace, Role
 from proto.plan import Plan
+from proto.scenario import Scenario
 from proto.site import BatterySwap
-from proto.telemetry import AgentStatus, TaskOutcome
+from proto.telemetry import AgentStatus, FlightState, TaskOutcome
 from sim_fleet import Fleet, FleetConfig, FleetThread
 from sim_fleet.from_proto import scenario_from_proto
 from sim_fleet.vehicle import AutopilotParams
@@ -22,6 +29,7 @@ from tests.support.processes import running, wait_until
 
 SPEEDUP = 10.0
 KEYS = KeySpace("default")
+LINK_CONFIG = AgentConfig(command_ack_timeout_s=0.3, command_retries=1, heartbeat_timeout_s=0.5)
 
 
 def fast_scenario():
@@ -34,6 +42,55 @@ def fast_scenario():
     ]
     site = msgspec.structs.replace(scenario.site, stations=stations)
     return msgspec.structs.replace(scenario, site=site)
+
+
+def start_fleet(scenario: Scenario | None = None, **config) -> FleetThread:
+    """``scenario`` (the fast paper one by default) in sim_fleet at SPEEDUP,
+    every vehicle on a free port; ``config``: FleetConfig fields."""
+    scenario = scenario or fast_scenario()
+    config = {"params": AutopilotParams(auto_disarm_s=30.0)} | config
+    world = scenario_from_proto(scenario.site, scenario.fleet)
+    return FleetThread(
+        Fleet(world, FleetConfig(speedup=SPEEDUP, rate_hz=50.0, base_port=0, **config))
+    ).start()
+
+
+async def until(predicate, timeout_s: float = 10.0, what: str = "") -> None:
+    deadline = time.monotonic() + timeout_s
+    while not predicate():
+        if time.monotonic() > deadline:
+            raise AssertionError(f"timed out waiting for {what or predicate}")
+        await asyncio.sleep(0.01)
+
+
+def fly(fleet, uav_id: str, scenario, *, site=None, url: str | None = None, **options) -> None:
+    """Run ``scenario(link)`` with a link to ``uav_id`` of the fleet once its
+    telemetry flows (``site``: whose origin, the fast paper site by default;
+    ``url``: another connection string; ``options``: the link's keyword arguments)."""
+    origin = (site or fast_scenario().site).origin
+
+    async def main() -> None:
+        where = url or f"udpout:127.0.0.1:{fleet.fleet.ports[uav_id]}"
+        config = options.pop("config", LINK_CONFIG)
+        link = MavlinkLink(where, SiteFrame(origin), config, **options)
+        link.start()
+        heartbeat = asyncio.create_task(link.run())
+        try:
+            await until(
+                lambda: (
+                    link.state.link_ok
+                    and link.state.known
+                    and link.state.battery_fraction > 0
+                    and link.state.flight_state is not FlightState.UNKNOWN
+                ),
+                what="telemetry",
+            )
+            await scenario(link)
+        finally:
+            heartbeat.cancel()
+            link.close()
+
+    asyncio.run(main())
 
 
 class GroundStation:
@@ -86,11 +143,7 @@ class GroundStation:
 @pytest.fixture
 def fleet():
     """The paper's fleet in sim_fleet at SPEEDUP, every vehicle on a free port."""
-    config = FleetConfig(
-        speedup=SPEEDUP, rate_hz=50.0, base_port=0, params=AutopilotParams(auto_disarm_s=30.0)
-    )
-    scenario = fast_scenario()
-    runner = FleetThread(Fleet(scenario_from_proto(scenario.site, scenario.fleet), config)).start()
+    runner = start_fleet()
     try:
         yield runner
     finally:

@@ -86,12 +86,12 @@ class FakeAutopilot:
             self.update(armed=True)
         return future
 
-    def takeoff(self, alt_m: float):
-        future = self._answer("takeoff", alt_m)
+    def takeoff(self, z_m: float):
+        future = self._answer("takeoff", z_m)
         if future.done() and future.exception() is None and self.state.armed:
             p = self.state.position
             self.update(
-                flight_state=FlightState.FLYING, position=Point(x_m=p.x_m, y_m=p.y_m, z_m=alt_m)
+                flight_state=FlightState.FLYING, position=Point(x_m=p.x_m, y_m=p.y_m, z_m=z_m)
             )
         return future
 

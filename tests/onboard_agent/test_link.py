@@ -2,55 +2,13 @@
 
 from __future__ import annotations
 
-import asyncio
-import time
-
 import pytest
 
-from onboard_agent import AgentConfig, CommandDenied, CommandTimeout
-from onboard_agent.autopilot.link import MavlinkLink
-from proto.geo import LocalFrame
+from onboard_agent import CommandDenied, CommandTimeout
 from proto.spots import spot_positions
-from proto.telemetry import FlightState
-from tests.onboard_agent.conftest import fast_scenario
+from tests.onboard_agent.conftest import fast_scenario, fly, until
 
 SITE = fast_scenario().site
-CONFIG = AgentConfig(command_ack_timeout_s=0.3, command_retries=1, heartbeat_timeout_s=0.5)
-
-
-async def until(predicate, timeout_s: float = 10.0, what: str = "") -> None:
-    deadline = time.monotonic() + timeout_s
-    while not predicate():
-        if time.monotonic() > deadline:
-            raise AssertionError(f"timed out waiting for {what or predicate}")
-        await asyncio.sleep(0.01)
-
-
-def fly(fleet, uav_id: str, scenario, *, url: str | None = None, **options) -> None:
-    """Run ``scenario(link)`` with a link to ``uav_id`` of the fleet (``url``:
-    another connection string; ``options``: the link's keyword arguments)."""
-
-    async def main() -> None:
-        where = url or f"udpout:127.0.0.1:{fleet.fleet.ports[uav_id]}"
-        link = MavlinkLink(where, LocalFrame(SITE.origin), options.pop("config", CONFIG), **options)
-        link.start()
-        heartbeat = asyncio.create_task(link.run())
-        try:
-            await until(
-                lambda: (
-                    link.state.link_ok
-                    and link.state.known
-                    and link.state.battery_fraction > 0
-                    and link.state.flight_state is not FlightState.UNKNOWN
-                ),
-                what="telemetry",
-            )
-            await scenario(link)
-        finally:
-            heartbeat.cancel()
-            link.close()
-
-    asyncio.run(main())
 
 
 def test_guided_takeoff_goto_land_with_positions_in_the_site_frame(fleet):

@@ -16,33 +16,21 @@ from pymavlink.dialects.v20 import ardupilotmega as dialect
 
 from onboard_agent import LinkLost
 from onboard_agent.autopilot.link import MavlinkLink
-from proto.geo import LocalFrame
+from proto.geo import SiteFrame
 from proto.telemetry import FlightState
-from sim_fleet import Fleet, FleetConfig, FleetThread
-from sim_fleet.from_proto import scenario_from_proto
-from sim_fleet.vehicle import AutopilotParams
-from tests.onboard_agent.conftest import SPEEDUP, fast_scenario
-from tests.onboard_agent.test_link import CONFIG, SITE, fly, until
+from tests.onboard_agent.conftest import (
+    LINK_CONFIG,
+    fast_scenario,
+    fly,
+    start_fleet,
+    until,
+)
 from tests.sim_fleet.mavclient import Client
 
 KEY = hashlib.sha256(b"uav-1 test passphrase").digest()
 FORCE_DISARM = 21196
 LOCAL = "127.0.0.1"
-
-
-def start_fleet(**config) -> FleetThread:
-    scenario = fast_scenario()
-    fleet = Fleet(
-        scenario_from_proto(scenario.site, scenario.fleet),
-        FleetConfig(
-            speedup=SPEEDUP,
-            rate_hz=50.0,
-            base_port=0,
-            params=AutopilotParams(auto_disarm_s=30.0),
-            **config,
-        ),
-    )
-    return FleetThread(fleet).start()
+SITE = fast_scenario().site
 
 
 @pytest.fixture
@@ -111,12 +99,12 @@ def test_a_signed_link_flies_and_a_stranger_without_the_key_cannot(signed_fleet)
         stranger.close()
 
 
-def never_finds_its_autopilot(fleet, config=CONFIG, **options) -> None:
+def never_finds_its_autopilot(fleet, config=LINK_CONFIG, **options) -> None:
     """A link to uav-1 that hears no autopilot it may fly: commands raise LinkLost."""
 
     async def main() -> None:
         url = f"udpout:{LOCAL}:{fleet.fleet.ports['uav-1']}"
-        link = MavlinkLink(url, LocalFrame(SITE.origin), config, **options)
+        link = MavlinkLink(url, SiteFrame(SITE.origin), config, **options)
         link.start()
         try:
             with pytest.raises(LinkLost):
@@ -165,7 +153,9 @@ def test_a_keyed_link_drops_and_counts_frames_not_signed_with_its_key():
 
 
 def test_another_systems_heartbeat_is_not_taken_for_the_autopilot(fleet):
-    never_finds_its_autopilot(fleet, dataclasses.replace(CONFIG, autopilot_system=2))  # uav-1: 1
+    never_finds_its_autopilot(
+        fleet, dataclasses.replace(LINK_CONFIG, autopilot_system=2)
+    )  # uav-1: 1
 
 
 def test_strangers_can_neither_crowd_out_the_agent_nor_silence_its_heartbeat(fleet):

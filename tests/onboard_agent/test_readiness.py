@@ -12,15 +12,12 @@ import pytest
 
 from onboard_agent import Agent, AgentConfig, CommandDenied
 from onboard_agent.autopilot.link import MavlinkLink
-from proto.geo import LocalFrame
+from proto.geo import SiteFrame
 from proto.spots import spot_positions
 from proto.telemetry import AgentState, FlightState
-from sim_fleet import Fleet, FleetConfig, FleetThread
-from sim_fleet.from_proto import scenario_from_proto
 from sim_fleet.vehicle import AutopilotParams
-from tests.onboard_agent.conftest import SPEEDUP, fast_scenario
+from tests.onboard_agent.conftest import SPEEDUP, fast_scenario, start_fleet, until
 from tests.onboard_agent.helpers import inspect_task, plan
-from tests.onboard_agent.test_link import until
 
 SCENARIO = fast_scenario()
 SITE = SCENARIO.site
@@ -31,13 +28,7 @@ CONFIG = AgentConfig(command_ack_timeout_s=0.3, command_retries=1, heartbeat_tim
 @pytest.fixture
 def warming():
     """The paper's fleet, warming up for WARMUP_S simulated seconds."""
-    config = FleetConfig(
-        speedup=SPEEDUP,
-        rate_hz=50.0,
-        base_port=0,
-        params=AutopilotParams(auto_disarm_s=30.0, warmup_s=WARMUP_S),
-    )
-    runner = FleetThread(Fleet(scenario_from_proto(SITE, SCENARIO.fleet), config)).start()
+    runner = start_fleet(SCENARIO, params=AutopilotParams(auto_disarm_s=30.0, warmup_s=WARMUP_S))
     try:
         yield runner
     finally:
@@ -56,7 +47,7 @@ def test_link_reports_position_and_battery_unknown_and_not_ready_until_warmed_up
     c1 = spot_positions(SITE.station("C1"), SCENARIO.fleet)[0]  # uav-1 sits on spot 0
 
     async def main() -> dict:
-        link = MavlinkLink(url(warming), LocalFrame(SITE.origin), CONFIG)
+        link = MavlinkLink(url(warming), SiteFrame(SITE.origin), CONFIG)
         link.start()
         heartbeat = asyncio.create_task(link.run())
         seen: dict = {}
@@ -108,7 +99,7 @@ def test_agent_is_not_ready_not_failed_no_false_emergency_and_flies_once_warmed_
     )
 
     async def main() -> dict:
-        link = MavlinkLink(url(warming), LocalFrame(SITE.origin), config)
+        link = MavlinkLink(url(warming), SiteFrame(SITE.origin), config)
         agent = Agent(
             "uav-1",
             SCENARIO,
@@ -160,7 +151,7 @@ def test_with_the_state_off_not_ready_is_reported_as_idle_or_busy_with_ready_fal
     config = dataclasses.replace(CONFIG, not_ready_state=False)
 
     async def main():
-        link = MavlinkLink(url(warming), LocalFrame(SITE.origin), config)
+        link = MavlinkLink(url(warming), SiteFrame(SITE.origin), config)
         agent = Agent("uav-1", SCENARIO, link, config)
         link.start()
         heartbeat = asyncio.create_task(link.run())

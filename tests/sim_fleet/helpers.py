@@ -112,8 +112,9 @@ def run_until(
 
 
 def airborne(w: World, v: Vehicle, alt_m: float = 10.0) -> None:
-    """GUIDED, arm, take off and wait until hovering at ``alt_m``."""
+    """GUIDED, arm, take off and wait until hovering ``alt_m`` above home."""
     assert command(w, v, 176, 1, Mode.GUIDED).result == 0
     assert command(w, v, 400, 1).result == 0
     assert command(w, v, 22, 0, 0, 0, 0, 0, 0, alt_m).result == 0
-    run_until(w, lambda: v.state == "flying" and abs(v.position[2] - alt_m) < 1e-6)
+    z = v.home[2] + alt_m
+    run_until(w, lambda: v.state == "flying" and abs(v.position[2] - z) < 1e-6)

@@ -11,6 +11,7 @@ os.environ["MAVLINK20"] = "1"
 from pymavlink import mavutil
 
 mavlink = mavutil.mavlink
+SPEEDUP = 20.0  # simulated seconds per wall second in the pymavlink tests
 
 
 class Client:
@@ -39,9 +40,14 @@ class Client:
         self.conn.close()
 
     def wait(
-        self, msg_type: str, pred: Callable[[Any], bool] = lambda m: True, timeout_s: float = 10.0
+        self,
+        msg_type: str | tuple[str, ...],
+        pred: Callable[[Any], bool] = lambda m: True,
+        timeout_s: float = 10.0,
     ) -> Any:
-        """The first ``msg_type`` message satisfying ``pred`` within the deadline."""
+        """The first ``msg_type`` message (or one of several types) satisfying
+        ``pred`` within the deadline."""
+        types = (msg_type,) if isinstance(msg_type, str) else msg_type
         deadline = time.monotonic() + timeout_s
         last_hello = time.monotonic()
         while time.monotonic() < deadline:
@@ -53,7 +59,7 @@ class Client:
                 continue
             if msg.get_type() == "STATUSTEXT":
                 self.texts.append(msg.text)
-            if msg.get_type() == msg_type and pred(msg):
+            if msg.get_type() in types and pred(msg):
                 return msg
         raise AssertionError(f"no {msg_type} matching within {timeout_s} s")
 

@@ -71,8 +71,8 @@ def test_disarm_in_flight_fails_unless_forced_then_falls(wv):
 def test_set_mode_rules(wv):
     _, v = wv
     assert ap.set_mode(v, 0, Mode.GUIDED).result is Result.DENIED  # no custom-mode flag
-    out = ap.set_mode(v, 1, 3)  # AUTO: not simulated
-    assert out.result is Result.FAILED and out.text == "No such mode 3"
+    out = ap.set_mode(v, 1, 2)  # ALT_HOLD: not simulated
+    assert out.result is Result.FAILED and out.text == "No such mode 2"
     assert ap.set_mode(v, 1, Mode.RTL).result is Result.ACCEPTED and v.mode is Mode.RTL
 
 

@@ -9,36 +9,10 @@ import pytest
 from sim_fleet import Fleet, FleetConfig, FleetThread
 from sim_fleet.modes import Mode
 from sim_fleet.vehicle import AutopilotParams
-from tests.sim_fleet.mavclient import Client, mavlink
+from tests.sim_fleet.mavclient import SPEEDUP, Client, mavlink
 from tests.sim_fleet.small_world import small_world
 
-SPEEDUP = 20.0
 ACCEPTED = mavlink.MAV_RESULT_ACCEPTED
-
-
-@pytest.fixture
-def fleet():
-    cfg = FleetConfig(
-        speedup=SPEEDUP,
-        rate_hz=50.0,
-        base_port=0,
-        params=AutopilotParams(auto_disarm_s=30.0, warmup_s=0.0),
-    )
-    runner = FleetThread(Fleet(small_world(2), cfg)).start()
-    try:
-        yield runner
-    finally:
-        runner.stop()
-
-
-@pytest.fixture
-def client(fleet):
-    port = fleet.fleet.ports["uav1"]
-    c = Client(port, target_system=1)
-    try:
-        yield c
-    finally:
-        c.close()
 
 
 def test_heartbeat_is_an_arducopter_quad(client):

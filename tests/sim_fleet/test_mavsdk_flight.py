@@ -1,6 +1,7 @@
 """MAVSDK-Python 4.x (a MAVLink client nobody here wrote) against the simulator,
 the way it talks to ArduCopter: health and armable after the GPS/EKF warm-up,
-the parameter protocol, arm / takeoff / goto_location / hold / land, the gripper.
+the parameter protocol, arm / takeoff / goto_location / hold / land, the gripper,
+a MissionRaw upload flown in AUTO.
 
 Like ArduCopter with ``SRx_`` rates at 0, the simulator streams only what is
 asked for, so the client sets the rates it needs (``set_rate_*``), as MAVSDK
@@ -10,11 +11,13 @@ users of ArduPilot do. Skipped when ``mavsdk`` is not installed.
 from __future__ import annotations
 
 import asyncio
+import math
 import time
 
 import pytest
 
 from sim_fleet import Fleet, FleetConfig, FleetThread
+from sim_fleet.auto_mission import WP_RADIUS_M
 from sim_fleet.vehicle import AutopilotParams
 from tests.sim_fleet.small_world import small_world
 
@@ -22,10 +25,12 @@ mavsdk = pytest.importorskip("mavsdk")
 from mavsdk.asyncio.mavsdk import Mavsdk  # noqa: E402
 from mavsdk.asyncio.plugins.action.action import ActionAsync  # noqa: E402
 from mavsdk.asyncio.plugins.gripper.gripper import GripperAsync  # noqa: E402
+from mavsdk.asyncio.plugins.mission_raw.mission_raw import MissionRawAsync  # noqa: E402
 from mavsdk.asyncio.plugins.param.param import ParamAsync  # noqa: E402
 from mavsdk.asyncio.plugins.telemetry.telemetry import TelemetryAsync  # noqa: E402
 from mavsdk.plugins.action.action import ActionError  # noqa: E402
 from mavsdk.plugins.gripper.gripper import GripperError  # noqa: E402
+from mavsdk.plugins.mission_raw.mission_raw import MissionItem  # noqa: E402
 
 SPEEDUP = 10.0
 WARMUP_S = 30.0  # simulated: 3 s of wall time at x10
@@ -218,3 +223,50 @@ def test_gripper_needs_grip_enable_then_grabs_and_delivers(fleet):
     assert seen["held"] is not None and seen["held"].id == "hammer"
     [delivery] = fleet.call(lambda: list(world.deliveries))
     assert (delivery.tool_id, delivery.worker_id) == ("hammer", "W1")
+
+
+def test_mission_raw_upload_arm_start_flies_the_waypoints_and_lands(fleet):
+    port = fleet.fleet.ports["uav1"]
+    world = fleet.fleet.world
+    auto = fleet.fleet.endpoints["uav1"].auto
+    wps = [(-10.0, 16.0, 5.0), (-4.0, 16.0, 6.0)]  # site metres; z above the pad
+
+    def item(seq, command, xyz=None, current=0):
+        x = y = 0
+        if xyz is not None:
+            lat, lon, _ = world.geo.to_geodetic(xyz)
+            x, y = round(lat * 1e7), round(lon * 1e7)
+        z = xyz[2] if xyz is not None else 0.0
+        return MissionItem(seq, 6, command, current, 1, 0.0, 0.0, 0.0, 0.0, x, y, z, 0)
+
+    items = [
+        item(0, 16, current=1),  # home's place, as ArduPilot missions start
+        MissionItem(1, 6, 22, 0, 1, 0.0, 0.0, 0.0, 0.0, 0, 0, 4.0, 0),  # takeoff to 4 m
+        item(2, 16, wps[0]),
+        item(3, 16, wps[1]),
+        item(4, 21),  # land where it is
+    ]
+
+    async def script(system, telemetry):
+        mission, action = MissionRawAsync(system), ActionAsync(system)
+        await ready(telemetry)
+        await mission.upload_mission(items)
+        downloaded = await mission.download_mission()
+        await action.arm()
+        await mission.start_mission()
+        await first(telemetry.subscribe_in_air(), bool)
+        await first(telemetry.subscribe_landed_state(), lambda s: int(s) == 1, 120.0)
+        await first(telemetry.subscribe_armed(), lambda armed: not armed)
+        return {"downloaded": downloaded}
+
+    seen = fly(port, script)
+    assert [i.command for i in seen["downloaded"]] == [16, 22, 16, 16, 21]
+    log = {seq: pos for seq, _, pos in fleet.call(lambda: list(auto.log))}
+    assert sorted(log) == [1, 2, 3, 4]
+    for seq, wp in zip((2, 3), wps, strict=True):
+        assert math.dist(log[seq], wp) <= WP_RADIUS_M
+    vehicle = world.vehicle("uav1")
+    landed = fleet.call(lambda: vehicle.position)
+    assert landed[2] == pytest.approx(0.0, abs=1e-3)
+    assert math.dist(landed, (wps[1][0], wps[1][1], 0.0)) <= WP_RADIUS_M + 0.5
+    assert fleet.call(lambda: (vehicle.mode.name, vehicle.armed)) == ("AUTO", False)
