@@ -12,7 +12,9 @@ drops above them); a worker the target is beside, such as the one a tool
 is dropped to, is passed at the target's height or higher. Flights to a
 station are legged the same way at the UAV's own height there (see
 :mod:`onboard_agent.spots`), so that UAVs heading for stations at once
-cross at different heights."""
+cross at different heights. The spots of a raised station (a roof) are
+cleared the same way: a UAV leaving one climbs clear of the deck before it
+heads for a lower target, and one flying to another crosses above it."""
 
 from __future__ import annotations
 

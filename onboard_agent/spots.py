@@ -14,7 +14,7 @@ import math
 
 from proto.geo import Point
 from proto.scenario import Scenario
-from proto.site import ChargingStation
+from proto.site import ChargingStation, Site
 from proto.spots import SpotClaim, StationSpots, spot_positions
 
 HOLD_STEP_M = 2.0
@@ -41,6 +41,17 @@ class Spots:
         self._claimed_s = -math.inf
         self._used_s: dict[str, float] = {}
         self._heard_s: dict[str, float] = {}
+
+    def raised_spots(self, site: Site) -> list[Point]:
+        """Every spot of a station standing above the site's ground (a roof):
+        obstacles a route must clear as it clears people (the deck is solid)."""
+        ground = site.safety.ground_z_m
+        return [
+            p
+            for s in site.stations
+            if s.position.z_m > ground
+            for p in spot_positions(s, self.fleet)
+        ]
 
     def update(self, feed: StationSpots, now_s: float) -> None:
         """The newest feed of a station, heard at ``now_s`` (an older stamp is ignored)."""

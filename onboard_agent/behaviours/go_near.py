@@ -160,8 +160,8 @@ class GoNear(AgentBehaviour):
         if self._yielding(point, now):
             return Status.RUNNING
         clear_m = ctx.surroundings.site.safety.people_clearance_m + config.route_margin_m
-        people = ctx.surroundings.people()
-        leg = route.next_leg(vehicle.position, point, people, clear_m, self.target.cruise_z(ctx))
+        obstacles = ctx.surroundings.people() + ctx.spots.raised_spots(ctx.surroundings.site)
+        leg = route.next_leg(vehicle.position, point, obstacles, clear_m, self.target.cruise_z(ctx))
         moved = self._sent is None or self._sent.distance_to(leg) > config.follow_threshold_m
         if moved or now - self._sent_at >= config.goto_resend_s:
             ctx.autopilot.goto(leg)

@@ -1,5 +1,6 @@
-"""A scenario of one's own, with its own site id, runs end to end; a
-process told another site id refuses to start and names both."""
+"""A scenario of one's own, with its own site id and a station on a roof,
+runs end to end; a process told another site id refuses to start and names
+both."""
 
 from __future__ import annotations
 
@@ -14,8 +15,18 @@ from linecrew.scenarios import ScenarioError, load
 PAPER = load("paper")
 
 
+def raised(station, z_m: float):
+    """``station`` on a roof ``z_m`` above the site's ground."""
+    return msgspec.structs.replace(
+        station, position=msgspec.structs.replace(station.position, z_m=z_m)
+    )
+
+
 def own_scenario(path) -> str:
-    site = msgspec.structs.replace(PAPER.site, id="line-7")
+    """The paper's world as site ``line-7``, with uav-1's home station C1 on
+    a 6 m roof: the delivery takes off from it and lands back on it."""
+    stations = [raised(s, 6.0) if s.id == "C1" else s for s in PAPER.site.stations]
+    site = msgspec.structs.replace(PAPER.site, id="line-7", stations=stations)
     first = [a for a in PAPER.actions if a.id in {"deliver-wrench", "inspect-towers"}]
     scenario = msgspec.structs.replace(PAPER, name="line-7", site=site, actions=first)
     path.write_bytes(msgspec.json.encode(scenario))

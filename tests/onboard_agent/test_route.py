@@ -7,10 +7,12 @@ from __future__ import annotations
 import itertools
 import math
 
+import msgspec
 import pytest
 
 from onboard_agent import AgentConfig
 from onboard_agent.route import ground_distance, next_leg
+from onboard_agent.spots import Spots
 from proto.telemetry import FlightState
 from tests.onboard_agent.helpers import SCENARIO, Rig, point
 
@@ -88,3 +90,19 @@ def test_the_flight_to_a_station_from_beside_a_worker_keeps_the_clearance(start,
     rig.run_until(flown, max_ticks=400)
     assert min(_closest(path, w) for w in (W2, W3)) >= CLEARANCE_M, path
     assert (path[-1].x_m, path[-1].y_m) == (station.x_m, station.y_m)
+
+
+def test_a_uav_on_a_roof_climbs_clear_of_the_deck_before_heading_for_a_lower_target():
+    """Met live: uav-1 re-tasked just above its 6 m roof pad flew straight
+    for a 3 m pick-up and sank into the deck (a crash, in the simulator)."""
+    roof = next(s for s in SCENARIO.site.stations if s.id == "C1")
+    roof = msgspec.structs.replace(roof, position=point(-10, 10, 6))
+    site = msgspec.structs.replace(SCENARIO.site, stations=[roof])
+    decks = Spots("uav-1", SCENARIO).raised_spots(site)
+    assert decks and all(p.z_m == 6 for p in decks)
+    here, pick_up = point(decks[0].x_m, decks[0].y_m, 6.5), point(1, 5, 3)
+    up = next_leg(here, pick_up, decks, CLEAR_M)
+    assert (up.x_m, up.y_m) == (here.x_m, here.y_m) and up.z_m >= 6 + CLEAR_M  # straight up
+    across = next_leg(up, pick_up, decks, CLEAR_M)
+    assert across == point(1, 5, up.z_m)  # level, above the deck, then down
+    assert Spots("uav-1", SCENARIO).raised_spots(SCENARIO.site) == []  # ground pads: none
