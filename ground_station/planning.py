@@ -87,6 +87,7 @@ def build_problem(
         reserve_fraction=min(1.0, fleet.reserve_fraction + PLANNING_MARGIN),
         min_altitude_m=safety.ground_z_m + safety.min_altitude_m,
         separation_m=safety.separation_m,
+        end=fleet.end.value,
         stations=tuple(
             pl.Station(
                 id=s.id,

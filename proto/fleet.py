@@ -35,6 +35,15 @@ class UavType(Record, frozen=True, kw_only=True):
     gripper: bool = False
 
 
+class MissionEnd(enum.StrEnum):
+    """Where the UAVs end the mission (the planner's ``Problem.end``)."""
+
+    HOME = "home"
+    """Each on its home station (the paper's "back to station")."""
+    ANY_STATION = "any_station"
+    """On any station with a pad free from the landing on."""
+
+
 class UavSpec(Record, frozen=True, kw_only=True):
     """One UAV of the fleet, by type, with the station it starts on."""
 
@@ -49,6 +58,8 @@ class Fleet(Message, frozen=True, kw_only=True):
     types: list[UavType]
     uavs: list[UavSpec]
     reserve_fraction: Fraction = 0.2
+    end: MissionEnd = MissionEnd.HOME
+    """Where the UAVs end the mission, with as many recharges as needed."""
 
     def type_of(self, uav_id: str) -> UavType | None:
         """The type of the UAV with this id, if both exist."""

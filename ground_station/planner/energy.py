@@ -62,17 +62,20 @@ def energy_after_recharge(
 
 
 class Site:
-    """Charging stations with memoised distance and nearest-station lookups,
-    and the index of each hold point's one-at-a-time reservation timeline in
-    the shared :class:`~ground_station.planner.pads.Pads` (after the
-    stations')."""
+    """Charging stations (``index`` by id) with memoised distance and
+    nearest-station lookups, the end-of-mission policy, and the index of
+    each hold point's one-at-a-time reservation timeline in the shared
+    :class:`~ground_station.planner.pads.Pads` (after the stations')."""
 
     __slots__ = (
         "_cand",
         "_dists",
         "_near",
+        "_within",
         "by_id",
         "charging",
+        "end",
+        "index",
         "points",
         "positions",
         "swap_s",
@@ -82,11 +85,14 @@ class Site:
     def __init__(self, problem: Problem) -> None:
         self.by_id = {s.id: s for s in problem.stations}
         self.charging = [s for s in problem.stations if s.pads > 0]
+        self.index = {s.id: i for i, s in enumerate(self.charging)}
         self.positions = [s.position_m for s in self.charging]
+        self.end = problem.end
         self.points = HoldPoints(problem, first=len(self.charging))
         self._near: dict[Vec3, tuple[float, int]] = {}
         self._dists: dict[Vec3, list[float]] = {}
         self._cand: dict[tuple[Vec3, Vec3], tuple[list[int], list[int], float]] = {}
+        self._within: dict[tuple[int, float], list[tuple[int, float]]] = {}
         swaps = [s.swap_s for s in self.charging if s.recharge == "swap"]
         self.swap_s = min(swaps, default=float("inf"))
         charges = [s.full_charge_s for s in self.charging if s.recharge == "charge"]
@@ -105,6 +111,18 @@ class Site:
             hit = [dist(pos, sp) for sp in self.positions]
             if len(self._dists) < 200_000:
                 self._dists[pos] = hit
+        return hit
+
+    def within(self, si: int, reach_m: float) -> list[tuple[int, float]]:
+        """(index, distance m) of the other charging stations at most
+        ``reach_m`` from station ``si``."""
+        key = (si, reach_m)
+        hit = self._within.get(key)
+        if hit is None:
+            row = self.dists(self.positions[si])
+            self._within[key] = hit = [
+                (j, d) for j, d in enumerate(row) if j != si and d <= reach_m
+            ]
         return hit
 
     def nearest(self, pos: Vec3) -> tuple[float, int]:

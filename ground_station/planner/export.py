@@ -4,10 +4,10 @@ from __future__ import annotations
 
 from math import dist
 
+from ground_station.planner.ending import end_steps
 from ground_station.planner.metrics import compute_metrics
 from ground_station.planner.result import Plan, Step, UavPlan, Unplaced
 from ground_station.planner.routes import Ctx
-from ground_station.planner.simulate import home_steps
 
 
 def to_step(raw: tuple) -> Step:
@@ -51,7 +51,7 @@ def export(ctx: Ctx) -> Plan:
         if r is None:
             uavs.append(UavPlan(uav_id=u.id))
             continue
-        home, res = home_steps(r.kin, ctx.site, pads, r.tail(), None)
+        home, res = end_steps(r.kin, ctx.site, pads, r.tail(), None)
         for si, s, e in res:
             pads.add(si, s, e, u.id)
         steps = tuple(to_step(s) for s in (*r.steps, *home))

@@ -23,10 +23,11 @@ from collections.abc import Callable
 from msgspec.structs import replace
 
 from ground_station.planner import heuristic
+from ground_station.planner.ending import end_steps
 from ground_station.planner.model import CostWeights
 from ground_station.planner.removal import remove_in_place
 from ground_station.planner.routes import Ctx, queue_order
-from ground_station.planner.simulate import Task, home_steps
+from ground_station.planner.simulate import Task
 
 THRESHOLD = 0.002
 """Accept a round up to this fraction worse than the current state."""
@@ -50,7 +51,7 @@ def objective(ctx: Ctx) -> tuple[int, float]:
     comp: dict[str, float] = {}
     makespan = now
     for r in ctx.routes.values():
-        home, _ = home_steps(r.kin, ctx.site, ctx.pads, r.tail(), None)
+        home, _ = end_steps(r.kin, ctx.site, ctx.pads, r.tail(), None)
         t = home[-1][3] if home else r.tail()[0]
         if t > makespan:
             makespan = t

@@ -19,6 +19,11 @@ Vec3 = tuple[float, float, float]
 Kind = Literal["inspect", "monitor", "deliver"]
 KINDS: tuple[str, ...] = ("deliver", "inspect", "monitor")
 
+End = Literal["home", "any_station"]
+"""Where UAVs end the mission: ``home``, each at its home station (the
+paper's "back to station"); ``any_station``, at home or at a station with a
+pad free for good from its landing on, never the last free one."""
+
 
 class Station(msgspec.Struct, frozen=True, kw_only=True):
     """A charging / battery-swap station (also a landing spot).
@@ -205,3 +210,6 @@ class Problem(msgspec.Struct, frozen=True, kw_only=True):
     """No two UAVs hover closer than this at once (metres, 3-D): points
     nearer each other are held one UAV at a time; the validator reports
     ``separation``."""
+    end: End = "home"
+    """End-of-mission policy (``End``), reached with as many recharges on the
+    way as needed; the validator reports ``not_home`` / ``end_station``."""

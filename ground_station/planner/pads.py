@@ -131,6 +131,13 @@ class Pads:
                 return start, d
         return None
 
+    def free_for_good(self, si: int, t: float, keep: int, ign: Ignore) -> bool:
+        """Whether a pad of station ``si`` is free from ``t`` on for good with
+        ``keep`` more left free beside it."""
+        cap = self._cap(si) - keep
+        busy = _busy(self._after(si, t), t, ign)
+        return cap >= 1 and self._fits(busy, cap, t, float("inf"))
+
     def remove_uav(self, uav_id: str, from_s: float, until_s: float = float("inf")) -> None:
         """Drop ``uav_id``'s reservations starting in [from_s, until_s)."""
         mine = self.by_uav.get(uav_id)

@@ -19,7 +19,7 @@ from ground_station.planner.pads import Ignore, Pads
 from ground_station.planner.recharge import emit_recharge, next_hop, recharge_option
 from ground_station.planner.state import Fail, Sim, State, Task
 
-__all__ = ["Fail", "Sim", "State", "Task", "advance", "home_steps", "monitor_reach", "simulate"]
+__all__ = ["Fail", "Sim", "State", "Task", "advance", "monitor_reach", "simulate"]
 
 MAX_HOPS = 12
 LONG_WAIT_S = 120.0
@@ -260,49 +260,3 @@ def _reach_once(
             if end_rc > anchor and (best is None or end_rc > best):
                 best = end_rc
     return best
-
-
-def home_steps(k: Kin, site: Site, pads: Pads, st: State, ign: Ignore) -> tuple[list, list]:
-    """Steps that bring the UAV home (recharging first if needed)."""
-    steps: list = []
-    res: list = []
-    t, pos, e, landed, _tool = st
-    d = dist(pos, k.home_pos)
-    if landed and d < 1e-9:
-        return steps, res
-    if e - d * k.wh_per_m >= k.reserve_wh - EPS_WH:
-        end = t + d / k.speed_mps
-        steps.append(
-            ("home", t, end, end, e - d * k.wh_per_m, k.home_pos, None, None, k.home, None, d)
-        )
-        return steps, res
-    rc = recharge_option(k, site, pads, st, k.home_pos, 0.0, None, ign, k.reserve_wh + 1e-4)
-    if rc is not None and rc.e_at_task >= k.reserve_wh - EPS_WH:
-        st = emit_recharge(k, site, st, rc, steps, res)
-        d = dist(st.pos, k.home_pos)
-        end = st.t + d / k.speed_mps
-        steps.append(
-            ("home", st.t, end, end, rc.e_at_task, k.home_pos, None, None, k.home, None, d)
-        )
-        return steps, res
-    # Cannot get home: land at the nearest station (landing spots are not pads).
-    dn, si = site.nearest(pos)
-    if si >= 0:
-        sp = site.positions[si]
-        end = t + dn / k.speed_mps
-        steps.append(
-            (
-                "home",
-                t,
-                end,
-                end,
-                e - dn * k.wh_per_m,
-                sp,
-                None,
-                None,
-                site.charging[si].id,
-                None,
-                dn,
-            )
-        )
-    return steps, res

@@ -63,7 +63,7 @@ def validate(problem: Problem, plan: Plan) -> list[Violation]:
         if uid in seen:
             rep.add("duplicate_uav", f"two step lists for {uid!r}", uid)
         seen.add(uid)
-        if not up.steps:
+        if not up.steps and not u.available:
             continue
         if not u.available:
             rep.add("uav_unavailable", "steps for an unavailable UAV", uid)
@@ -76,6 +76,8 @@ def validate(problem: Problem, plan: Plan) -> list[Violation]:
         # the reserve on a pad): until its first recharge or landing the UAV may
         # only wait, recharge or land, and must not run dry.
         emergency = u.energy_wh - to_station * wh_per_m < floor - TOL_WH
+        if not emergency:  # a UAV in a battery fault only lands, where it can
+            _check_end(rep, problem, u, up.steps, stations, pad_use)
         normal_floor = floor
         if emergency:
             floor = 0.0
@@ -280,6 +282,23 @@ def _check_separation(rep: _Report, separation_m: float, holds) -> None:  # type
                     uid,
                 )
         active.append(hold)
+
+
+def _check_end(rep: _Report, problem: Problem, u, steps, stations, pad_use) -> None:  # type: ignore[no-untyped-def]
+    """``problem.end``: the UAV ends landed at home, or (``any_station``) at
+    a station, where away from home it holds a pad from its landing on."""
+    last = steps[-1] if steps else None
+    pos = last.position_m if last else u.position_m
+    at = [s for s in stations.values() if dist(s.position_m, pos) <= TOL_M]
+    landed = (last.kind in ("recharge", "home", "wait") and bool(at)) if last else not u.airborne
+    if landed and any(s.id == u.home_station for s in at):
+        return
+    if problem.end == "home":
+        rep.add("not_home", f"ends at {pos}, not on {u.home_station}", u.id)
+    elif not landed or not at:
+        rep.add("end_station", f"ends at {pos}, not on a station", u.id)
+    else:
+        pad_use[at[0].id].append((last.end_s if last else problem.now_s, float("inf")))
 
 
 def _check_pads(rep: _Report, stations, pad_use) -> None:  # type: ignore[no-untyped-def]
