@@ -50,6 +50,10 @@ def start(args: argparse.Namespace, process: str, mode: str = "client") -> BusCo
     )
 
 
+WAIT_SLICE_S = 0.2
+"""How long the main thread sleeps at a time while it waits for a signal."""
+
+
 class Shutdown:
     """Set when SIGINT or SIGTERM arrives; usable from threads and asyncio."""
 
@@ -83,8 +87,14 @@ class Shutdown:
                 self._loop.call_soon_threadsafe(self._async_event.set)
 
     def wait(self, timeout_s: float | None = None) -> bool:
-        """Block until shutdown is requested (or the timeout passes)."""
-        return self._event.wait(timeout_s)
+        """Block until shutdown is requested (or the timeout passes). Waits in
+        short slices: a signal the kernel hands to another thread (Zenoh's)
+        runs its Python handler only once the main thread wakes up."""
+        if timeout_s is not None:
+            return self._event.wait(timeout_s)
+        while not self._event.wait(WAIT_SLICE_S):
+            pass
+        return True
 
     async def wait_async(self) -> None:
         """Await shutdown from the running event loop."""

@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import json
 import os
+import pathlib
 import re
 import signal
 import subprocess
@@ -21,6 +22,24 @@ def survivors(run_dir) -> list[str]:
     """Processes whose command line mentions the run directory."""
     out = subprocess.run(["pgrep", "-af", str(run_dir)], capture_output=True, text=True)
     return [line for line in out.stdout.splitlines() if "pgrep" not in line]
+
+
+def children(pid: int) -> set[int]:
+    """The processes whose parent is ``pid`` now (the router's command line
+    does not name the run directory)."""
+    found = set()
+    for stat in pathlib.Path("/proc").glob("[0-9]*/stat"):
+        try:
+            ppid = int(stat.read_text().rsplit(")", 1)[1].split()[1])
+        except (OSError, ValueError, IndexError):
+            continue  # gone meanwhile
+        if ppid == pid:
+            found.add(int(stat.parent.name))
+    return found
+
+
+def alive(pids: set[int]) -> set[int]:
+    return {p for p in pids if pathlib.Path(f"/proc/{p}").exists()}
 
 
 @pytest.fixture
@@ -89,6 +108,8 @@ def test_up_prints_a_working_url_and_token_and_stops_cleanly(up, tmp_path):
 
 def test_a_killed_up_takes_its_children_with_it(up):
     proc, run_dir, _ = up
-    assert survivors(run_dir)
+    kids = children(proc.popen.pid)
+    assert survivors(run_dir) and len(kids) >= 5  # router, gs, sim, gateway, agents
     os.kill(proc.popen.pid, signal.SIGKILL)
     wait_until(lambda: not survivors(run_dir), 30, "children gone after SIGKILL of up")
+    wait_until(lambda: not alive(kids), 30, "the router gone too")
