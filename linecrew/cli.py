@@ -22,6 +22,7 @@ COMMANDS: dict[str, tuple[str, str]] = {
     "ground-station": ("ground_station.main:main", "run the mission manager and planner"),
     "sim": ("sim_fleet.main:main", "run the MAVLink fleet simulator and human tracker"),
     "agent": ("onboard_agent.main:main", "run one UAV's onboard agent (or: agent tree)"),
+    "agents": ("onboard_agent.fleet_host:main", "simulation only: many UAVs' agents, one process"),
     "gateway": ("ground_station.gateway.main:main", "run the operator REST API"),
     "health": ("linecrew.health:main", "is a process's liveliness token up (healthchecks)"),
     "up": ("linecrew.launch.up:main", "run router, ground station, gateway, sim and agents"),
@@ -46,6 +47,7 @@ BENCHES: dict[str, tuple[str, str]] = {
     "sim": ("sim_fleet.bench:main", "simulator physics rate, telemetry rate, CPU"),
     "planner": ("ground_station.planner.cli:bench_main", "planner speed and plan quality"),
     "live-plan": ("ground_station.bench_quality:main", "the live plan against the offline one"),
+    "fleet": ("linecrew.launch.bench_fleet:main", "start-up, CPU, RSS, latencies of N UAVs"),
 }
 
 

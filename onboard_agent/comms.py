@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import asyncio
 import logging
+from collections.abc import Callable
 
 from linecrew.bus import Bus
 from onboard_agent.agent import Agent
@@ -29,8 +30,11 @@ log = logging.getLogger(__name__)
 class Comms:
     """Binds one :class:`Agent` to the bus; all callbacks run on the loop."""
 
-    def __init__(self, bus: Bus, keys: KeySpace, agent: Agent) -> None:
+    def __init__(
+        self, bus: Bus, keys: KeySpace, agent: Agent, on_plan: Callable[[], None] = lambda: None
+    ) -> None:
         self.bus = bus
+        self.on_plan = on_plan  # after every plan offered (the runtime then ticks at once)
         self.keys = keys
         self.agent = agent
         self.uav_id = agent.ctx.uav_id
@@ -63,6 +67,7 @@ class Comms:
         async with self.bus.subscribe_async(self.keys.plan(self.uav_id), Plan) as sub:
             async for _key, plan in sub:
                 self.agent.offer_plan(plan)
+                self.on_plan()
 
     async def _poses(self) -> None:
         async with self.bus.subscribe_async(self.keys.all_human_poses(), HumanPose) as sub:
@@ -107,6 +112,7 @@ class Comms:
         for plan in reply.plans:
             if plan.uav_id == self.uav_id:
                 self.agent.offer_plan(plan)
+                self.on_plan()
 
     async def _telemetry(self) -> None:
         period = 1.0 / self.config.telemetry_hz

@@ -20,8 +20,32 @@ from onboard_agent import export
 from onboard_agent.config import AgentConfig
 from onboard_agent.runtime import run_agent
 from proto.errors import LinecrewError
+from proto.scenario import Scenario
 
 log = logging.getLogger(__name__)
+
+
+def add_flight_arguments(p: argparse.ArgumentParser) -> None:
+    """The flags of every agent, also of a :mod:`onboard_agent.fleet_host`."""
+    p.add_argument(
+        "--autopilot-system",
+        type=int,
+        help="the autopilot's MAVLink system id (default: the first autopilot heard)",
+    )
+    p.add_argument("--scenario", default="paper", help="scenario name or YAML/JSON file")
+    p.add_argument("--tick-hz", type=float, help="behaviour-tree ticks per second (10)")
+    p.add_argument("--link-timeout", type=float, help="agent_link_timeout_s (3.0)")
+
+
+def settings(args: argparse.Namespace) -> tuple[AgentConfig, Scenario]:
+    """The agent's configuration and scenario from the flags; raises
+    ``ValueError`` or :class:`LinecrewError`."""
+    config = AgentConfig.from_env(
+        tick_hz=args.tick_hz,
+        agent_link_timeout_s=args.link_timeout,
+        autopilot_system=args.autopilot_system,
+    )
+    return config, scenarios.load(args.scenario, site=args.site)
 
 
 def parser() -> argparse.ArgumentParser:
@@ -34,19 +58,12 @@ def parser() -> argparse.ArgumentParser:
         help="pymavlink connection string, e.g. udpout:127.0.0.1:14560, tcp:host:5760",
     )
     p.add_argument(
-        "--autopilot-system",
-        type=int,
-        help="the autopilot's MAVLink system id (default: the first autopilot heard)",
-    )
-    p.add_argument(
         "--mavlink-key",
         metavar="FILE",
         help="sign the MAVLink link with this key file's passphrase and accept only "
         "packets signed with it (the autopilot must hold the same key)",
     )
-    p.add_argument("--scenario", default="paper", help="scenario name or YAML/JSON file")
-    p.add_argument("--tick-hz", type=float, help="behaviour-tree ticks per second (10)")
-    p.add_argument("--link-timeout", type=float, help="agent_link_timeout_s (3.0)")
+    add_flight_arguments(p)
     return p
 
 
@@ -71,12 +88,7 @@ def main(argv: list[str] | None = None) -> int:
     args = parser().parse_args(argv)
     bus_config = start(args, "agent")
     try:
-        config = AgentConfig.from_env(
-            tick_hz=args.tick_hz,
-            agent_link_timeout_s=args.link_timeout,
-            autopilot_system=args.autopilot_system,
-        )
-        scenario = scenarios.load(args.scenario, site=args.site)
+        config, scenario = settings(args)
         signing_key = load_key(args.mavlink_key) if args.mavlink_key else None
     except (ValueError, LinecrewError) as exc:
         log.error("cannot start: %s", exc)

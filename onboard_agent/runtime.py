@@ -22,8 +22,33 @@ from proto.scenario import Scenario
 log = logging.getLogger(__name__)
 
 
-async def tick_loop(agent: Agent, comms: Comms) -> None:
-    """Tick at ``tick_hz`` on the monotonic clock (no drift, no bursts)."""
+class Wakeup:
+    """A sleep that :meth:`set` ends early (a plan arrived: tick at once)."""
+
+    def __init__(self) -> None:
+        self._future: asyncio.Future[None] | None = None
+
+    def set(self) -> None:
+        """End the current sleep, if any."""
+        if self._future is not None and not self._future.done():
+            self._future.set_result(None)
+
+    async def sleep(self, delay_s: float) -> None:
+        """Sleep ``delay_s`` seconds or until :meth:`set`."""
+        loop = asyncio.get_running_loop()
+        self._future = loop.create_future()
+        timer = loop.call_later(delay_s, self.set)
+        try:
+            await self._future
+        finally:
+            timer.cancel()
+            self._future = None
+
+
+async def tick_loop(agent: Agent, comms: Comms, wakeup: Wakeup) -> None:
+    """Tick at ``tick_hz`` on the monotonic clock (no drift, no bursts), and
+    once more at once when ``wakeup`` is set: a new plan starts (and shows
+    in the status) without waiting for the next tick."""
     period = 1.0 / agent.ctx.config.tick_hz
     next_at = time.monotonic()
     while True:
@@ -31,9 +56,11 @@ async def tick_loop(agent: Agent, comms: Comms) -> None:
             agent.tick()
         except Exception:  # a bug in one behaviour must not stop the UAV being reported
             log.exception("tick failed", extra={"uav_id": agent.ctx.uav_id})
-        comms.after_tick(time.monotonic())
-        next_at = max(next_at + period, time.monotonic())
-        await asyncio.sleep(max(0.0, next_at - time.monotonic()))
+        now = time.monotonic()
+        comms.after_tick(now)
+        if now >= next_at:  # a tick on the schedule, not an extra one
+            next_at = max(next_at + period, now)
+        await wakeup.sleep(max(0.0, next_at - time.monotonic()))
 
 
 async def run_agent(
@@ -64,11 +91,12 @@ async def run_agent(
     bus = await asyncio.to_thread(Bus.open, bus_config)
     link.start()
     try:
-        comms = Comms(bus, KeySpace(site or scenario.site.id), agent)
+        wakeup = Wakeup()
+        comms = Comms(bus, KeySpace(site or scenario.site.id), agent, wakeup.set)
         tasks = [
             asyncio.create_task(link.run(), name="mavlink"),
             asyncio.create_task(comms.run(), name="comms"),
-            asyncio.create_task(tick_loop(agent, comms), name="ticks"),
+            asyncio.create_task(tick_loop(agent, comms, wakeup), name="ticks"),
         ]
         log.info("agent %s up, autopilot %s", uav_id, autopilot_url, extra={"uav_id": uav_id})
         stopper = asyncio.ensure_future(stop)

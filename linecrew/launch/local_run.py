@@ -1,7 +1,9 @@
 """Everything of a linecrew deployment on this machine, as child processes:
 router, ground station, gateway, simulator and one agent per UAV, on
 loopback with free ports, started in dependency order and checked healthy.
-Used by ``linecrew up`` and ``linecrew demo``.
+Used by ``linecrew up``, ``linecrew demo`` and ``linecrew bench fleet``. With
+``agents_per_process`` > 1 the simulated UAVs' agents run in groups, each
+group in one :mod:`onboard_agent.fleet_host` (simulation only).
 
 The run directory gets the scenario (``scenario.json``), what the run is
 (``run.json``: speed-up, gateway, start), one log per process, the ground
@@ -17,6 +19,7 @@ import json
 import logging
 import pathlib
 import time
+from collections.abc import Callable
 
 import httpx
 import msgspec
@@ -28,7 +31,7 @@ from linecrew.client.gateway import Gateway, http_client
 from linecrew.launch import secure
 from linecrew.launch.flight_log import FlightLog
 from linecrew.launch.ports import free_udp_block
-from linecrew.launch.supervisor import Supervisor
+from linecrew.launch.supervisor import Child, Supervisor
 from proto.keys import KeySpace, Role
 from proto.scenario import Scenario
 
@@ -48,6 +51,13 @@ class RunOptions:
     session_file: pathlib.Path | None = None  # default: $LINECREW_SESSION or .linecrew/
     register: bool = True  # list the run in the session file while it is up
     warmup_s: float | None = None  # the simulated autopilots' GPS/EKF warm-up (mission s)
+    agents_per_process: int = 1  # >1: simulated UAVs' agents share hosts (fleet_host)
+
+    def __post_init__(self) -> None:
+        if self.agents_per_process < 1:
+            raise ValueError("agents_per_process must be at least 1")
+        if self.secure and self.agents_per_process > 1:
+            raise ValueError("a secure run keeps one agent process per UAV (own identity)")
 
 
 class LocalRun:
@@ -193,21 +203,54 @@ class LocalRun:
             )
             self.session_file = session.register(entry, opts.session_file)
 
-        for uav_id in uavs:
-            agent = sup.start(
-                f"agent-{uav_id}",
-                "onboard_agent",
-                *common(uav_id),
-                "--uav",
-                uav_id,
-                "--scenario",
-                str(scenario_file),
-                "--autopilot",
-                f"udpout:127.0.0.1:{self.mavlink_ports[uav_id]}",
-                *(["--mavlink-key", profile.mavlink_key(uav_id)] if profile else []),
-            )
-            sup.wait_ready(agent, lambda u=uav_id: self._alive(Role.AGENT, u), wait)
+        self._start_agents(uavs, base_port, common, profile)
         log.info("all processes healthy", extra={"run_dir": str(self.run_dir)})
+
+    def _start_agents(
+        self,
+        uavs: list[str],
+        base_port: int,
+        common: Callable[[str], list[str]],
+        profile: secure.SecureProfile | None,
+    ) -> None:
+        """Every agent process (one per UAV, or hosts of ``agents_per_process``)
+        at once; then wait until every UAV's token is up."""
+        per, scenario_file = self.options.agents_per_process, str(self.run_dir / "scenario.json")
+        groups: list[tuple[Child, list[str]]] = []
+        for number, first in enumerate(range(0, len(uavs), per), start=1):
+            group = uavs[first : first + per]
+            port = base_port + first
+            name, module, args = self._agent_process(number, group, port, common, profile)
+            child = self.supervisor.start(name, module, *args, "--scenario", scenario_file)
+            groups.append((child, group))
+        for child, group in groups:
+            self.supervisor.wait_ready(
+                child, lambda g=group: self.agents_alive(g), self.options.start_timeout_s
+            )
+
+    def _agent_process(
+        self,
+        number: int,
+        group: list[str],
+        port: int,
+        common: Callable[[str], list[str]],
+        profile: secure.SecureProfile | None,
+    ) -> tuple[str, str, list[str]]:
+        """Name, module and flags of agent process ``number`` (from 1), for
+        ``group``'s UAVs, the first of whose autopilots is on UDP ``port``."""
+        if self.options.agents_per_process > 1:
+            where = ["--uavs", ",".join(group), "--autopilot-base-port", str(port)]
+            return f"agents-{number}", "onboard_agent.fleet_host", [*common("agents"), *where]
+        [uav_id] = group
+        key = ["--mavlink-key", profile.mavlink_key(uav_id)] if profile else []
+        where = ["--uav", uav_id, "--autopilot", f"udpout:127.0.0.1:{port}"]
+        return f"agent-{uav_id}", "onboard_agent", [*common(uav_id), *where, *key]
+
+    def agents_alive(self, uavs: list[str]) -> bool:
+        """Whether the liveliness tokens of all ``uavs``' agents are up."""
+        assert self.bus is not None
+        key = self.keys.all_alive(Role.AGENT)
+        return {self.keys.alive(Role.AGENT, u) for u in uavs} <= self.bus.alive(key, 0.5)
 
     def _describe(self, started_s: float) -> None:
         """``run.json``: what ``linecrew report`` needs to know of the run."""

@@ -48,8 +48,22 @@ def add_run_arguments(parser: argparse.ArgumentParser) -> None:
         help="mutual TLS and access control on the bus (dev certificates in the run directory)",
     )
     parser.add_argument(
+        "--agents-per-process",
+        type=_at_least_one,
+        default=1,
+        metavar="N",
+        help="host the simulated UAVs' agents N to a process (default 1: one process per UAV)",
+    )
+    parser.add_argument(
         "--log-level", default="warning", help="of every process: debug, info, warning, error"
     )
+
+
+def _at_least_one(text: str) -> int:
+    number = int(text)
+    if number < 1:
+        raise argparse.ArgumentTypeError("must be at least 1")
+    return number
 
 
 def scenario_from(args: argparse.Namespace) -> Scenario:
@@ -61,9 +75,16 @@ def scenario_from(args: argparse.Namespace) -> Scenario:
 
 
 def options_from(args: argparse.Namespace) -> RunOptions:
-    """Run options from the flags."""
+    """Run options from the flags; a secure run keeps one agent process per
+    UAV (each its own bus identity)."""
+    if args.secure and args.agents_per_process > 1:
+        raise SecureProfileError("--secure runs one agent process per UAV")
     return RunOptions(
-        speedup=args.speedup, gateway_port=args.port, run_dir=args.run_dir, secure=args.secure
+        speedup=args.speedup,
+        gateway_port=args.port,
+        run_dir=args.run_dir,
+        secure=args.secure,
+        agents_per_process=args.agents_per_process,
     )
 
 

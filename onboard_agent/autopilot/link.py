@@ -1,8 +1,11 @@
 """The MAVLink link to one autopilot (ArduCopter GUIDED conventions).
 
-This is the only pymavlink importer of the agent. A daemon thread blocks in
-``recv_match`` and hands every message to the asyncio loop with
-``loop.call_soon_threadsafe``; all state lives on the loop thread. Commands
+This is the only pymavlink importer of the agent. All state lives on the
+asyncio loop: a UDP link (non-blocking socket) is read by the loop itself
+(``add_reader``: no thread, no wake-up without a datagram); other links
+(TCP with reconnection, serial) by a daemon thread blocking in
+``recv_match`` that hands every message over with
+``loop.call_soon_threadsafe``. Commands
 are asyncio tasks: each sends a COMMAND_LONG and waits for its COMMAND_ACK,
 resending up to ``command_retries`` times; a refusal becomes
 :class:`CommandDenied` carrying the autopilot's last STATUSTEXT as the reason.
@@ -131,6 +134,7 @@ class MavlinkLink:
         self._conn: Any = None
         self._loop: asyncio.AbstractEventLoop | None = None
         self._thread: threading.Thread | None = None
+        self._reading_fd: int | None = None  # the UDP socket the loop reads
         self._closing = threading.Event()
         self._battery_status_seen = False
         self._tasks: set[asyncio.Task[Any]] = set()
@@ -141,7 +145,7 @@ class MavlinkLink:
     # -- lifecycle ---------------------------------------------------------------
 
     def start(self) -> None:
-        """Open the connection and start the receive thread (on the loop)."""
+        """Open the connection and start receiving (call on the loop)."""
         self._loop = asyncio.get_running_loop()
         self._found = asyncio.Event()
         system, component = self._source
@@ -152,11 +156,16 @@ class MavlinkLink:
             self._conn.setup_signing(
                 self._signing_key, initial_timestamp=signing_timestamp(), link_id=0
             )
-        if isinstance(self._conn, mavutil.mavudp) and not self._conn.udp_server:
+        udp = isinstance(self._conn, mavutil.mavudp)
+        if udp and not self._conn.udp_server:
             host, port = self._conn.destination_addr  # udpout: hear only that address
             self._conn.port.connect((socket.gethostbyname(host), port))
-        self._thread = threading.Thread(target=self._receive, name="mavlink-rx", daemon=True)
-        self._thread.start()
+        if udp:
+            self._loop.add_reader(self._conn.port.fileno(), self._on_readable)
+            self._reading_fd = self._conn.port.fileno()
+        else:
+            self._thread = threading.Thread(target=self._receive, name="mavlink-rx", daemon=True)
+            self._thread.start()
         self._send_heartbeat()  # a udpout peer learns our address from what we send
 
     async def run(self) -> None:
@@ -178,6 +187,9 @@ class MavlinkLink:
         self._closing.set()
         for task in list(self._tasks):
             task.cancel()
+        if self._reading_fd is not None and self._loop is not None:
+            self._loop.remove_reader(self._reading_fd)
+            self._reading_fd = None
         if self._thread is not None:
             self._thread.join(2.0)
         if self._conn is not None:
@@ -297,6 +309,7 @@ class MavlinkLink:
     # -- receiving -------------------------------------------------------------------
 
     def _receive(self) -> None:
+        """The receive thread of a link the loop cannot read itself."""
         while not self._closing.is_set():
             try:
                 msg = self._conn.recv_match(blocking=True, timeout=0.2)
@@ -307,15 +320,30 @@ class MavlinkLink:
                 continue
             if msg is None:
                 continue
-            if msg.get_type() == "BAD_DATA":
-                if msg.reason == "Invalid signature":
-                    self._drop(f"unsigned or wrongly signed {msg.reason!r}")
-                continue
             try:
                 assert self._loop is not None
-                self._loop.call_soon_threadsafe(self._on_message, msg)
+                self._loop.call_soon_threadsafe(self._dispatch, msg)
             except RuntimeError:  # the loop is closed: we are shutting down
                 return
+
+    def _on_readable(self) -> None:
+        """Parse every message waiting on the UDP socket (on the loop)."""
+        while True:
+            try:
+                msg = self._conn.recv_msg()
+            except Exception as exc:  # a bad packet or a socket error: wait for the next
+                log.debug("mavlink receive failed: %s", exc)
+                return
+            if msg is None:
+                return
+            self._dispatch(msg)
+
+    def _dispatch(self, msg: Any) -> None:
+        if msg.get_type() == "BAD_DATA":
+            if msg.reason == "Invalid signature":
+                self._drop(f"unsigned or wrongly signed {msg.reason!r}")
+            return
+        self._on_message(msg)
 
     def _drop(self, what: str) -> None:
         """Count a message we do not act on; log the first and every 100th."""

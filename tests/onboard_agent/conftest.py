@@ -14,7 +14,7 @@ import pytest
 
 from linecrew.bus import Bus
 from linecrew.scenarios import load
-from onboard_agent import AgentConfig
+from onboard_agent import Agent, AgentConfig
 from onboard_agent.autopilot.link import MavlinkLink
 from proto.geo import SiteFrame
 from proto.keys import KeySpace, Role
@@ -53,6 +53,18 @@ def start_fleet(scenario: Scenario | None = None, **config) -> FleetThread:
     return FleetThread(
         Fleet(world, FleetConfig(speedup=SPEEDUP, rate_hz=50.0, base_port=0, **config))
     ).start()
+
+
+def sped_up_agent(link: MavlinkLink, config: AgentConfig, scenario: Scenario) -> Agent:
+    """uav-1's agent on ``link``, its clocks ``SPEEDUP`` times real time (as the sim's)."""
+    return Agent(
+        "uav-1",
+        scenario,
+        link,
+        config,
+        clock=lambda: time.monotonic() * SPEEDUP,
+        wall=lambda: time.time() * SPEEDUP,
+    )
 
 
 async def until(predicate, timeout_s: float = 10.0, what: str = "") -> None:

@@ -11,16 +11,15 @@ import time
 import msgspec
 import pytest
 
-from onboard_agent import Agent
 from onboard_agent.autopilot.link import MavlinkLink
 from proto.geo import Point, SiteFrame
 from proto.plan import GoHomeTask, InspectTask, Waypoint
 from proto.telemetry import OutcomeResult
 from tests.onboard_agent.conftest import (
     LINK_CONFIG,
-    SPEEDUP,
     fast_scenario,
     fly,
+    sped_up_agent,
     start_fleet,
     until,
 )
@@ -125,14 +124,7 @@ async def run_agent(fleet, the_plan, timeout_s: float = 60.0) -> dict:
     an outcome, sampling the truth against what the agent believes."""
     url = f"udpout:127.0.0.1:{fleet.fleet.ports['uav-1']}"
     link = MavlinkLink(url, SiteFrame(SCENARIO.site.origin), LINK_CONFIG)
-    agent = Agent(
-        "uav-1",
-        SCENARIO,
-        link,
-        LINK_CONFIG,
-        clock=lambda: time.monotonic() * SPEEDUP,
-        wall=lambda: time.time() * SPEEDUP,
-    )
+    agent = sped_up_agent(link, LINK_CONFIG, SCENARIO)
     agent.ground_station("gs", True)
     link.start()
     heartbeat = asyncio.create_task(link.run())

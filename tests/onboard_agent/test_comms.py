@@ -5,7 +5,6 @@ the traffic report, worker poses trusted only on their own worker's key."""
 from __future__ import annotations
 
 import asyncio
-import time
 
 from linecrew.bus import Bus
 from onboard_agent.comms import Comms
@@ -20,17 +19,10 @@ from proto.telemetry import (
     Traffic,
     TrafficEntry,
 )
+from tests.onboard_agent.conftest import until
 from tests.onboard_agent.helpers import Rig, inspect_task, plan
 
 KEYS = KeySpace("default")
-
-
-async def until(predicate, timeout_s: float = 10.0, what: str = "") -> None:
-    deadline = time.monotonic() + timeout_s
-    while not predicate():
-        if time.monotonic() > deadline:
-            raise AssertionError(f"timed out waiting for {what or predicate}")
-        await asyncio.sleep(0.01)
 
 
 def test_comms_round_trip(bus_config):

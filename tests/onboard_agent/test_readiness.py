@@ -16,7 +16,12 @@ from proto.geo import SiteFrame
 from proto.spots import spot_positions
 from proto.telemetry import AgentState, FlightState
 from sim_fleet.vehicle import AutopilotParams
-from tests.onboard_agent.conftest import SPEEDUP, fast_scenario, start_fleet, until
+from tests.onboard_agent.conftest import (
+    fast_scenario,
+    sped_up_agent,
+    start_fleet,
+    until,
+)
 from tests.onboard_agent.helpers import inspect_task, plan
 
 SCENARIO = fast_scenario()
@@ -100,14 +105,7 @@ def test_agent_is_not_ready_not_failed_no_false_emergency_and_flies_once_warmed_
 
     async def main() -> dict:
         link = MavlinkLink(url(warming), SiteFrame(SITE.origin), config)
-        agent = Agent(
-            "uav-1",
-            SCENARIO,
-            link,
-            config,
-            clock=lambda: time.monotonic() * SPEEDUP,
-            wall=lambda: time.time() * SPEEDUP,
-        )
+        agent = sped_up_agent(link, config, SCENARIO)
         agent.ground_station("gs", True)
         link.start()
         heartbeat = asyncio.create_task(link.run())
