@@ -186,7 +186,9 @@ def test_a_hung_agent_s_replacement_is_not_sent_to_where_it_hovers(truth):
     watch = truth.submit(monitor("W2", 1, 240))["action_id"]
 
     def on_station() -> set[str]:
-        return truth.watching(truth.samples[-1], W2, 4.0, SAFETY.monitor_height_m)
+        """UAVs at W2's ring for the watch (another may only be flying past)."""
+        ring = truth.watching(truth.samples[-1], W2, 4.0, SAFETY.monitor_height_m)
+        return ring & truth.working_on(watch) if ring else ring
 
     [victim] = truth.until("a UAV watches W2", on_station, 60)
     faults = ProcessFaults(truth.run)

@@ -74,6 +74,13 @@ class TruthLog:
                 return False
             raise
 
+    def working_on(self, action_id: str) -> set[str]:
+        """The UAVs whose agents report a task of ``action_id`` as theirs now
+        (a UAV only passing through a worker's ring is not among them)."""
+        fleet = self.gateway.call("GET", "/v1/fleet")
+        tasks = {u["uav_id"]: (u.get("status") or {}).get("task_id") or "" for u in fleet}
+        return {uav for uav, task in tasks.items() if task.startswith(f"{action_id}.")}
+
     def events(self) -> list[GsEvent]:
         assert self.run.bus is not None
         reply = self.run.bus.query(
