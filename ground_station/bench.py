@@ -22,7 +22,6 @@ from __future__ import annotations
 
 import argparse
 import json
-import os
 import pathlib
 import random
 import subprocess
@@ -37,6 +36,7 @@ import msgspec
 from ground_station.light_agent import LightAgent
 from linecrew.bus import Bus, BusConfig
 from linecrew.bus.router_process import router_process
+from linecrew.launch.proc_stats import cpu_s
 from linecrew.scenarios import load, with_fleet_size
 from proto import (
     ActionList,
@@ -171,12 +171,6 @@ def _event_to_plan(
     return latencies
 
 
-def _cpu_s(pid: int) -> float:
-    """User + system CPU seconds of process ``pid`` so far (Linux /proc)."""
-    fields = pathlib.Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()
-    return (int(fields[11]) + int(fields[12])) / os.sysconf("SC_CLK_TCK")
-
-
 def _improvements(watch: _EventWatch, since: float) -> set[int]:
     """Epochs of the improvements adopted since ``since``."""
     return {
@@ -217,9 +211,9 @@ def _stability(
     improved = _improvements(watch, since)
     epochs = {e.epoch for t, e in changes if t >= since} - improved
     before = {e.epoch for t, e in changes if t < since}
-    cpu = _cpu_s(gs_pid)
+    cpu = cpu_s(gs_pid)
     time.sleep(steady_s)
-    cpu = _cpu_s(gs_pid) - cpu
+    cpu = cpu_s(gs_pid) - cpu
     improved = _improvements(watch, since)  # adopted late: counted apart, not as steady
     quiet = {
         e.epoch

@@ -66,8 +66,12 @@ class Comms:
     async def _plans(self) -> None:
         async with self.bus.subscribe_async(self.keys.plan(self.uav_id), Plan) as sub:
             async for _key, plan in sub:
-                self.agent.offer_plan(plan)
-                self.on_plan()
+                self._offer(plan)
+
+    def _offer(self, plan: Plan) -> None:
+        """Hand ``plan`` to the agent, then wake its tick loop."""
+        self.agent.offer_plan(plan)
+        self.on_plan()
 
     async def _poses(self) -> None:
         async with self.bus.subscribe_async(self.keys.all_human_poses(), HumanPose) as sub:
@@ -111,8 +115,7 @@ class Comms:
             return
         for plan in reply.plans:
             if plan.uav_id == self.uav_id:
-                self.agent.offer_plan(plan)
-                self.on_plan()
+                self._offer(plan)
 
     async def _telemetry(self) -> None:
         period = 1.0 / self.config.telemetry_hz

@@ -176,9 +176,8 @@ class LocalRun:
         sup.wait_ready(sim, lambda: self._alive(Role.SIM, "sim"), wait)
 
         gateway_port = opts.gateway_port or free_port()
-        https = (
-            ["--tls-cert", profile.https()[0], "--tls-key", profile.https()[1]] if profile else []
-        )
+        cert, key = profile.https() if profile else ("", "")
+        https = ["--tls-cert", cert, "--tls-key", key] if profile else []
         self.ca_file = profile.ca() if profile else None
         self.url = f"{'https://localhost' if profile else 'http://127.0.0.1'}:{gateway_port}"
         token_file = self.run_dir / "token"
