@@ -156,16 +156,6 @@ class LivePlan:
         live = self.session
         before = improvement.objective(live.ctx)
         snap = live.ctx.snapshot()
-        work = live
-        if restart and self.can_restart(frozen):
-            work = pl.Session(live.problem, self._tunings()[self._starts])
-            self._starts += 1
-        elif self._kept is not None:
-            work, state = self._kept
-            work.ctx.restore(state)
-        ctx = work.ctx
-        pinned = set(ctx.pinned)
-        ctx.pinned = pinned | frozen
         stopped: list[bool] = []
 
         def stop() -> bool:
@@ -174,6 +164,18 @@ class LivePlan:
                 return True
             return False
 
+        work = live
+        if restart and self.can_restart(frozen):
+            fresh = pl.Session.build_until(live.problem, self._tunings()[self._starts], stop)
+            if fresh is None:
+                return None  # interrupted mid-construction: this start is tried again
+            work, self._starts = fresh, self._starts + 1
+        elif self._kept is not None:
+            work, state = self._kept
+            work.ctx.restore(state)
+        ctx = work.ctx
+        pinned = set(ctx.pinned)
+        ctx.pinned = pinned | frozen
         try:
             improvement.improve(ctx, stop, max_rounds=rounds, seed=seed)
         finally:

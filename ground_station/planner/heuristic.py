@@ -7,6 +7,7 @@ recharges come from ``simulate``; monitoring lives in ``monitor``.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from math import dist
 
 from ground_station.planner import insertion, monitor
@@ -228,7 +229,19 @@ def place_action(ctx: Ctx, a: Action, only: list[int] | None = None) -> None:
 
 def build(problem: Problem, options: Options | None = None) -> Ctx:
     """Run the heuristic over the whole queue; returns the planning state."""
+    ctx = build_until(problem, options, lambda: False)
+    assert ctx is not None  # never told to stop
+    return ctx
+
+
+def build_until(
+    problem: Problem, options: Options | None, should_stop: Callable[[], bool]
+) -> Ctx | None:
+    """:func:`build`, polling ``should_stop`` between actions: None if stopped
+    (a construction from scratch of a large problem takes a few hundred ms)."""
     ctx = new_ctx(problem, options or Options())
     for a in queue_order(problem.actions):
+        if should_stop():
+            return None
         place_action(ctx, a)
     return ctx

@@ -10,6 +10,8 @@ the heuristic's cheapest insertion; other routes are not rebuilt. Running
 
 from __future__ import annotations
 
+from collections.abc import Callable
+
 import msgspec
 
 from ground_station.planner import heuristic, monitor
@@ -20,7 +22,7 @@ from ground_station.planner.load import check_problem
 from ground_station.planner.model import Action, InspectAction, MonitorAction, Problem, Uav, Vec3
 from ground_station.planner.removal import remove_in_place
 from ground_station.planner.result import Plan
-from ground_station.planner.routes import Options, Route, emergency_landing, queue_order
+from ground_station.planner.routes import Ctx, Options, Route, emergency_landing, queue_order
 from ground_station.planner.simulate import State, Task, simulate
 
 replace = msgspec.structs.replace
@@ -69,11 +71,25 @@ Event = (
 class Session:
     """A problem, its planning state, and incremental updates."""
 
-    def __init__(self, problem: Problem, options: Options | None = None) -> None:
+    def __init__(
+        self, problem: Problem, options: Options | None = None, ctx: Ctx | None = None
+    ) -> None:
+        """Plan ``problem`` from scratch, or take ``ctx``, a planning state
+        of it (:meth:`build_until`)."""
         check_problem(problem)
         self.problem = problem
-        self.ctx = heuristic.build(problem, options or Options())
+        self.ctx = ctx if ctx is not None else heuristic.build(problem, options or Options())
         self._pending: list[str] = []
+
+    @classmethod
+    def build_until(
+        cls, problem: Problem, options: Options | None, should_stop: Callable[[], bool]
+    ) -> Session | None:
+        """A new session, its construction polling ``should_stop`` between
+        actions; None if stopped."""
+        check_problem(problem)
+        ctx = heuristic.build_until(problem, options, should_stop)
+        return None if ctx is None else cls(problem, ctx=ctx)
 
     def plan(self) -> Plan:
         """The current plan."""

@@ -192,3 +192,23 @@ def test_a_steady_mission_issues_no_epoch_over_a_long_mission_time(tmp_path):
         gs.settle(improve=True)
     assert gs.store.counter("epoch") == epoch
     assert [e for e in gs.events[events:] if e.kind == EventKind.PLAN_CHANGED] == []
+
+
+def test_an_improvement_restarting_from_scratch_yields_to_a_trigger_mid_construction(tmp_path):
+    """A restart builds a whole plan (hundreds of ms at 100 UAVs): a trigger
+    must not wait for it. Interrupted, the live plan and the starts left stay."""
+    gs = loaded(tmp_path)
+    live = gs.replanner.live
+    before = live.session.plan()
+    starts = live._starts
+    calls = [0]
+
+    def stop() -> bool:
+        calls[0] += 1
+        return calls[0] > 3  # three actions placed, then the trigger comes
+
+    assert live.can_restart(set())
+    assert live.improve(50, 0, set(), stop, restart=True) is None
+    assert calls[0] == 4
+    assert live._starts == starts  # the same start is tried on the next attempt
+    assert live.session.plan() == before

@@ -151,3 +151,24 @@ def test_random_event_sequences_keep_plans_valid(seed, kinds) -> None:
             a = next(x for x in s.problem.actions if x.id == aids[-1])
             s.apply(ActionChanged(action=replace(a, weight=9.0)))
         check(s)
+
+
+def _stop_after(polls: int):
+    """A ``should_stop`` that says stop from its ``polls``-th call on; and the count."""
+    calls = [0]
+
+    def stop() -> bool:
+        calls[0] += 1
+        return calls[0] >= polls
+
+    return stop, calls
+
+
+def test_a_construction_from_scratch_stops_between_actions_when_told():
+    problem = generate(4, 12, seed=3)
+    stop, calls = _stop_after(5)
+    assert Session.build_until(problem, None, stop) is None
+    assert calls[0] == 5  # polled before each action, stopped at the fifth
+    full = Session.build_until(problem, None, lambda: False)
+    assert full is not None
+    assert full.plan() == Session(problem).plan()
