@@ -1,6 +1,7 @@
 """The MAVLink link to one autopilot (ArduCopter GUIDED conventions).
 
-This is the only pymavlink importer of the agent. All state lives on the
+With :mod:`~onboard_agent.autopilot.reports` (what the autopilot's messages
+say about the vehicle) the only pymavlink importer of the agent. All state lives on the
 asyncio loop: a UDP link (non-blocking socket) is read by the loop itself
 (``add_reader``: no thread, no wake-up without a datagram); other links
 (TCP with reconnection, serial) by a daemon thread blocking in
@@ -24,8 +25,6 @@ finding the autopilot, and again after a heartbeat loss or when positions
 stop while heartbeats go on, the link asks for its telemetry by stream group
 (REQUEST_DATA_STREAM) and per message (SET_MESSAGE_INTERVAL), including the
 readiness reports (SYS_STATUS, GPS_RAW_INT, EKF_STATUS_REPORT, HOME_POSITION).
-A GLOBAL_POSITION_INT of lat = lon = 0 (no EKF origin yet) or without a 3-D
-fix leaves the position unknown; the battery is unknown until reported.
 
 Only the configured autopilot is heard: a ``udpout:`` socket is connected to
 its address (the kernel drops datagrams from anyone else), messages from any
@@ -38,8 +37,6 @@ counted in ``dropped``.
 from __future__ import annotations
 
 import asyncio
-import collections
-import dataclasses
 import logging
 import os
 import socket
@@ -54,31 +51,13 @@ from pymavlink import mavutil
 from linecrew.mavlink_keys import signing_timestamp
 from onboard_agent.autopilot.errors import CommandDenied, CommandTimeout, LinkLost
 from onboard_agent.autopilot.protocol import VehicleState
+from onboard_agent.autopilot.reports import MODE_NUMBERS, VehicleReports
 from onboard_agent.config import AgentConfig
-from proto.geo import GeoPoint, Point, SiteFrame, Vector
-from proto.telemetry import FlightState
+from proto.geo import Point, SiteFrame
 
 log = logging.getLogger(__name__)
 mav = mavutil.mavlink
 
-# ArduCopter custom_mode numbers
-COPTER_MODES = {
-    0: "STABILIZE",
-    2: "ALT_HOLD",
-    3: "AUTO",
-    4: "GUIDED",
-    5: "LOITER",
-    6: "RTL",
-    9: "LAND",
-    17: "BRAKE",
-}
-MODE_NUMBERS = {name: number for number, name in COPTER_MODES.items()}
-LANDED_STATES = {
-    mav.MAV_LANDED_STATE_ON_GROUND: FlightState.LANDED,
-    mav.MAV_LANDED_STATE_IN_AIR: FlightState.FLYING,
-    mav.MAV_LANDED_STATE_TAKEOFF: FlightState.TAKING_OFF,
-    mav.MAV_LANDED_STATE_LANDING: FlightState.LANDING,
-}
 POSITION_ONLY = 0b110111111000  # SET_POSITION_TARGET type_mask: use x, y, z only
 STREAMS_HZ = {
     "GLOBAL_POSITION_INT": 5.0,
@@ -94,12 +73,7 @@ DATA_STREAMS_HZ = {  # the ArduPilot stream groups holding the above (REQUEST_DA
     mav.MAV_DATA_STREAM_POSITION: 5,
     mav.MAV_DATA_STREAM_EXTRA3: 1,
 }
-PREARM_BIT = mav.MAV_SYS_STATUS_PREARM_CHECK
-ARM_TEXTS = ("PreArm:", "Arm:")  # ArduCopter's reasons for refusing to arm
 STREAMS_STALE_S = 3.0  # no position this long with heartbeats arriving: ask again
-CRASH_TEXT = "Crash:"  # ArduCopter's crash check ("Crash: Disarming")
-GRIPPER_TEXT = "Gripper:"  # what a gripper says it did (our simulator; a load sensor's driver)
-TEXT_FRESH_S = 2.0  # a STATUSTEXT this recent explains a refused command
 
 
 class MavlinkLink:
@@ -124,21 +98,16 @@ class MavlinkLink:
         self._source = (source_system, source_component)
         self._signing_key = signing_key
         self.dropped = 0  # messages from another sender, or not signed with our key
-        self._state = VehicleState()
+        self.reports = VehicleReports(frame, clock)
         self._target: tuple[int, int] | None = None
         self._found: asyncio.Event | None = None
         self._acks: dict[int, asyncio.Future[Any]] = {}
-        self._last_heartbeat = -1e9
-        self._last_text = ("", -1e9)
-        self._texts: collections.deque[tuple[str, float]] = collections.deque(maxlen=8)
         self._conn: Any = None
         self._loop: asyncio.AbstractEventLoop | None = None
         self._thread: threading.Thread | None = None
         self._reading_fd: int | None = None  # the UDP socket the loop reads
         self._closing = threading.Event()
-        self._battery_status_seen = False
         self._tasks: set[asyncio.Task[Any]] = set()
-        self._last_position = -1e9
         self._streams_asked = -1e9
         self._streams_task: asyncio.Task[None] | None = None
 
@@ -172,13 +141,14 @@ class MavlinkLink:
         """Send our heartbeat at 1 Hz and watch the autopilot's, until closed."""
         while not self._closing.is_set():
             self._send_heartbeat()
-            silent = self.clock() - self._last_heartbeat > self.config.heartbeat_timeout_s
-            if silent and self._state.link_ok:
+            reports = self.reports
+            silent = self.clock() - reports.last_heartbeat > self.config.heartbeat_timeout_s
+            if silent and reports.state.link_ok:
                 log.warning("autopilot heartbeat lost", extra={"url": self.url})
-                self._state = dataclasses.replace(self._state, link_ok=False)
+                reports.update(link_ok=False)
             now = self.clock()
-            starved = now - self._last_position > STREAMS_STALE_S
-            if self._state.link_ok and starved and now - self._streams_asked > STREAMS_STALE_S:
+            starved = now - reports.last_position > STREAMS_STALE_S
+            if reports.state.link_ok and starved and now - self._streams_asked > STREAMS_STALE_S:
                 self._request_streams()  # a rebooted autopilot forgets what it was asked
             await asyncio.sleep(1.0)
 
@@ -198,7 +168,7 @@ class MavlinkLink:
 
     @property
     def state(self) -> VehicleState:
-        return self._state
+        return self.reports.state
 
     # -- commands (call on the loop thread) ----------------------------------------
 
@@ -216,7 +186,7 @@ class MavlinkLink:
         """Climb to the site height ``z_m``. NAV_TAKEOFF is above home, which
         ArduCopter sets where it arms (the new HOME_POSITION may still be on
         its way): above where the vehicle stands."""
-        above = z_m - self._state.position.z_m
+        above = z_m - self.reports.state.position.z_m
         return self._spawn(
             self._command("takeoff", mav.MAV_CMD_NAV_TAKEOFF, 0, 0, 0, 0, 0, 0, above)
         )
@@ -225,11 +195,11 @@ class MavlinkLink:
         return self._spawn(self._command("land", mav.MAV_CMD_NAV_LAND))
 
     def grab(self) -> asyncio.Task[None]:
-        self._state = dataclasses.replace(self._state, gripper_text="")
+        self.reports.update(gripper_text="")
         return self._spawn(self._command("gripper grab", mav.MAV_CMD_DO_GRIPPER, 1, 1))
 
     def release(self) -> asyncio.Task[None]:
-        self._state = dataclasses.replace(self._state, gripper_text="")
+        self.reports.update(gripper_text="")
         return self._spawn(self._command("gripper release", mav.MAV_CMD_DO_GRIPPER, 1, 0))
 
     def change_speed(self, speed_mps: float) -> asyncio.Task[None]:
@@ -268,7 +238,7 @@ class MavlinkLink:
             if ack.result == mav.MAV_RESULT_ACCEPTED:
                 return
             result = mav.enums["MAV_RESULT"][ack.result].name.removeprefix("MAV_RESULT_")
-            raise CommandDenied(name, result, self._texts_since(sent_at))
+            raise CommandDenied(name, result, self.reports.texts_since(sent_at))
         tries = self.config.command_retries + 1
         raise CommandTimeout(f"{name}: no COMMAND_ACK after {tries} tries")
 
@@ -295,16 +265,6 @@ class MavlinkLink:
         self._tasks.discard(task)
         if not task.cancelled() and task.exception() is not None:
             log.debug("command ended: %s", task.exception())
-
-    def _recent_text(self) -> str:
-        text, stamp = self._last_text
-        return text if self.clock() - stamp <= TEXT_FRESH_S else ""
-
-    def _texts_since(self, since: float) -> str:
-        """Every STATUSTEXT since ``since`` (ArduCopter sends one per failed
-        pre-arm check before the ACK), else the last one if fresh."""
-        texts = [text for text, stamp in self._texts if stamp >= since]
-        return "; ".join(dict.fromkeys(texts)) or self._recent_text()
 
     # -- receiving -------------------------------------------------------------------
 
@@ -368,79 +328,16 @@ class MavlinkLink:
         if self._target is None or not self._from_autopilot(msg):
             return
         if kind == "HEARTBEAT":
-            self._on_heartbeat(msg)
-            return
-        s = self._state
-        match kind:
-            case "GLOBAL_POSITION_INT":
-                self._last_position = self.clock()
-                no_fix = 0 <= s.gps_fix_type < 3
-                if (msg.lat == 0 and msg.lon == 0) or no_fix:  # no position yet: not 0 N 0 E
-                    self._state = dataclasses.replace(s, known=False)
-                    return
-                geo = GeoPoint(lat_deg=msg.lat / 1e7, lon_deg=msg.lon / 1e7, alt_m=msg.alt / 1000)
-                position = self.frame.to_local(geo)
-                velocity = Vector(
-                    east_mps=msg.vy / 100, north_mps=msg.vx / 100, up_mps=-msg.vz / 100
-                )
-                heading = msg.hdg / 100 if msg.hdg != 65535 else s.heading_deg
-                self._state = dataclasses.replace(
-                    s, position=position, geo=geo, velocity=velocity, heading_deg=heading
-                )
-                self._state = dataclasses.replace(self._state, known=True)
-            case "EXTENDED_SYS_STATE" if s.flight_state is not FlightState.CRASHED:
-                state = LANDED_STATES.get(msg.landed_state, FlightState.UNKNOWN)
-                self._state = dataclasses.replace(s, flight_state=state)
-            case "BATTERY_STATUS" if msg.battery_remaining >= 0:
-                self._battery_status_seen = True
-                charging = msg.charge_state == mav.MAV_BATTERY_CHARGE_STATE_CHARGING
-                fraction = msg.battery_remaining / 100
-                self._state = dataclasses.replace(
-                    s, battery_fraction=fraction, charging=charging, battery_known=True
-                )
-            case "SYS_STATUS":
-                self._on_sys_status(msg)
-            case "GPS_RAW_INT":
-                self._state = dataclasses.replace(s, gps_fix_type=msg.fix_type)
-                if msg.fix_type < 3 and s.known:
-                    self._state = dataclasses.replace(self._state, known=False)
-            case "EKF_STATUS_REPORT":
-                self._state = dataclasses.replace(s, ekf_flags=msg.flags)
-            case "HOME_POSITION":
-                lat, lon = msg.latitude / 1e7, msg.longitude / 1e7
-                home = GeoPoint(lat_deg=lat, lon_deg=lon, alt_m=msg.altitude / 1000)
-                if home != s.home:
-                    log.info("autopilot home %s", home)
-                self._state = dataclasses.replace(s, home=home)
-            case "COMMAND_ACK":
-                future = self._acks.get(msg.command)
-                final = msg.result != mav.MAV_RESULT_IN_PROGRESS
-                if future is not None and not future.done() and final:
-                    future.set_result(msg)
-            case "STATUSTEXT":
-                self._last_text = (msg.text, self.clock())
-                self._texts.append(self._last_text)
-                if msg.text.startswith(ARM_TEXTS):
-                    self._state = dataclasses.replace(s, arm_text=msg.text)
-                if msg.text.startswith(GRIPPER_TEXT):
-                    self._state = dataclasses.replace(s, gripper_text=msg.text)
-                elif msg.text.startswith(CRASH_TEXT):
-                    self._crashed(msg.text)
-                log.info("autopilot: %s", msg.text)
-
-    def _on_sys_status(self, msg: Any) -> None:
-        s = self._state
-        changes: dict[str, Any] = {}
-        if msg.onboard_control_sensors_present & PREARM_BIT:
-            ok = bool(msg.onboard_control_sensors_health & PREARM_BIT)
-            changes["prearm_ok"] = ok
-            if ok:
-                changes["arm_text"] = ""
-        if msg.battery_remaining >= 0 and not self._battery_status_seen:
-            changes["battery_fraction"] = msg.battery_remaining / 100
-            changes["battery_known"] = True
-        if changes:
-            self._state = dataclasses.replace(s, **changes)
+            returned = self.reports.heartbeat(msg)
+            if returned and (self._streams_task is None or self._streams_task.done()):
+                self._request_streams()  # back after a loss: it may have rebooted
+        elif kind == "COMMAND_ACK":
+            future = self._acks.get(msg.command)
+            final = msg.result != mav.MAV_RESULT_IN_PROGRESS
+            if future is not None and not future.done() and final:
+                future.set_result(msg)
+        else:
+            self.reports.fold(msg)
 
     def _find(self, msg: Any) -> None:
         """Take the sender of ``msg`` as our autopilot if it is one we may fly."""
@@ -455,27 +352,6 @@ class MavlinkLink:
         self._found.set()
         log.info("autopilot found: system %d on %s", system, self.url)
         self._request_streams()
-
-    def _on_heartbeat(self, msg: Any) -> None:
-        self._last_heartbeat = self.clock()
-        armed = bool(msg.base_mode & mav.MAV_MODE_FLAG_SAFETY_ARMED)
-        mode = COPTER_MODES.get(msg.custom_mode, str(msg.custom_mode))
-        if not self._state.link_ok:
-            log.info("autopilot heartbeat received")
-            if self._streams_task is None or self._streams_task.done():
-                self._request_streams()  # back after a loss: it may have rebooted
-        s = self._state
-        in_air = s.flight_state in (FlightState.FLYING, FlightState.TAKING_OFF)
-        fell = s.armed and not armed and in_air and mode not in ("LAND", "RTL")
-        if msg.system_status == mav.MAV_STATE_EMERGENCY or fell:
-            self._crashed("emergency state" if armed else "disarmed in the air")
-        self._state = dataclasses.replace(self._state, armed=armed, mode=mode, link_ok=True)
-
-    def _crashed(self, why: str) -> None:
-        """The vehicle fell or hit the ground: it reports CRASHED from now on."""
-        if self._state.flight_state is not FlightState.CRASHED:
-            log.warning("vehicle crashed: %s", why)
-            self._state = dataclasses.replace(self._state, flight_state=FlightState.CRASHED)
 
     def _request_streams(self) -> None:
         if self._streams_task is not None and not self._streams_task.done():
