@@ -36,6 +36,7 @@ import msgspec
 from ground_station.light_agent import LightAgent
 from linecrew.bus import Bus, BusConfig
 from linecrew.bus.router_process import router_process
+from linecrew.latency import percentile_ms
 from linecrew.launch.proc_stats import cpu_s
 from linecrew.scenarios import load, with_fleet_size
 from proto import (
@@ -272,13 +273,6 @@ def _silence_to_lost(
     }
 
 
-def _pct(values: list[float], q: float) -> float:
-    ordered = sorted(values)
-    if not ordered:
-        return float("nan")
-    return ordered[min(len(ordered) - 1, int(q * len(ordered)))] * 1e3
-
-
 def run(
     uavs: int,
     events: int,
@@ -358,10 +352,10 @@ def run(
         "actions_preloaded": preload,
         "preload_planned_s": preload_s,
         "events": len(latencies),
-        "event_to_plan_p50_ms": _pct(latencies, 0.5),
-        "event_to_plan_p99_ms": _pct(latencies, 0.99),
-        "submit_reply_p50_ms": _pct(replies, 0.5),
-        "submit_reply_p99_ms": _pct(replies, 0.99),
+        "event_to_plan_p50_ms": percentile_ms(latencies, 0.5),
+        "event_to_plan_p99_ms": percentile_ms(latencies, 0.99),
+        "submit_reply_p50_ms": percentile_ms(replies, 0.5),
+        "submit_reply_p99_ms": percentile_ms(replies, 0.99),
         "submit_reply_big_inspect_ms": big[0] * 1e3 if big else float("nan"),
         "big_inspect_waypoints": big_inspect,
         **stability,

@@ -22,6 +22,7 @@ import time
 from linecrew.bus.config import BusConfig
 from linecrew.bus.router_process import router_process
 from linecrew.bus.session import Bus
+from linecrew.latency import summary_ms
 from proto import (
     GeoPoint,
     GetHistory,
@@ -48,14 +49,6 @@ def _telemetry(stamp: float) -> Telemetry:
     )
 
 
-def _percentiles(values: list[float]) -> dict[str, float]:
-    if not values:
-        return {"p50_ms": float("nan"), "p99_ms": float("nan")}
-    ordered = sorted(values)
-    p99 = ordered[min(len(ordered) - 1, int(0.99 * len(ordered)))]
-    return {"p50_ms": statistics.median(ordered) * 1e3, "p99_ms": p99 * 1e3}
-
-
 def _latency(pub: Bus, sub: Bus, count: int, period_s: float) -> dict[str, float]:
     """Send ``count`` messages every ``period_s`` (0: flat out); receive latencies."""
     key = KEYS.telemetry("uav-1")
@@ -77,7 +70,7 @@ def _latency(pub: Bus, sub: Bus, count: int, period_s: float) -> dict[str, float
             pub.publish(key, _telemetry(time.perf_counter()))
         done.wait(5.0)
         elapsed = time.perf_counter() - started
-    result = _percentiles(latencies)
+    result = summary_ms(latencies)
     result.update(sent=count, received=len(latencies), msgs_per_s=len(latencies) / elapsed)
     return result
 
@@ -123,7 +116,7 @@ def _query_rtt(server: Bus, client: Bus, count: int) -> dict[str, float]:
         rtts.append(time.perf_counter() - started)
     loop.call_soon_threadsafe(stop.set)
     thread.join(5)
-    result = _percentiles(rtts)
+    result = summary_ms(rtts)
     result.update(queries=len(rtts), failed=failed)
     return result
 
@@ -193,7 +186,9 @@ def _print_table(results: dict[str, dict[str, float]]) -> None:
     Console().print(table)
 
 
-def _number(value: float) -> str:
+def _number(value: float | None) -> str:
+    if value is None:
+        return "-"
     if isinstance(value, int) or abs(value) >= 100:
         return f"{value:,.0f}"
     return f"{value:.3g}"

@@ -27,7 +27,6 @@ import json
 import os
 import pathlib
 import random
-import statistics
 import sys
 import tempfile
 import threading
@@ -36,6 +35,7 @@ import time
 import msgspec
 
 from ground_station.bench import random_inspection
+from linecrew.latency import summary_ms
 from linecrew.launch.local_run import LocalRun, RunOptions
 from linecrew.launch.proc_stats import KINDS, measure
 from linecrew.launch.supervisor import StartError
@@ -119,19 +119,6 @@ def _reached(series: list[tuple[float, int]], epoch: int, since: float) -> float
     return next((t for t, e in series if t >= since and e >= epoch), None)
 
 
-def _percentiles(values: list[float]) -> dict[str, float | None]:
-    """p50 / p99 / max in milliseconds (None without values)."""
-    if not values:
-        return {"p50_ms": None, "p99_ms": None, "max_ms": None}
-    ordered = sorted(values)
-    p99 = ordered[min(len(ordered) - 1, int(0.99 * len(ordered)))]
-    return {
-        "p50_ms": statistics.median(ordered) * 1e3,
-        "p99_ms": p99 * 1e3,
-        "max_ms": ordered[-1] * 1e3,
-    }
-
-
 def _submits(run: LocalRun, watch: FleetWatch, count: int, seed: int) -> dict[str, object]:
     """POST ``count`` inspections one at a time, each after the last one's plan."""
     rng = random.Random(seed)
@@ -150,9 +137,9 @@ def _submits(run: LocalRun, watch: FleetWatch, count: int, seed: int) -> dict[st
     return {
         "submits": count,
         "submit_5xx": errors,
-        "submit": _percentiles(replies),
-        "event_to_plan": {"n": len(plans), **_percentiles(plans)},
-        "event_to_plan_on_bus": _percentiles(on_bus),
+        "submit": summary_ms(replies),
+        "event_to_plan": {"n": len(plans), **summary_ms(plans)},
+        "event_to_plan_on_bus": summary_ms(on_bus),
     }
 
 
