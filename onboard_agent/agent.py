@@ -90,9 +90,12 @@ class Agent:
         self._adopted(verdict)
         return verdict
 
-    def announce(self, generation: str | None, epoch: int) -> None:
-        """The ground station's generation and newest epoch (its traffic report)."""
-        self._adopted(self.mission.announce(generation, epoch))
+    def announce(self, generation: str | None, epoch: int) -> PlanVerdict | None:
+        """The ground station's generation and newest epoch (its traffic
+        report); the verdict on a held plan it now covers, if any."""
+        verdict = self.mission.announce(generation, epoch)
+        self._adopted(verdict)
+        return verdict
 
     def _adopted(self, verdict: PlanVerdict | None) -> None:
         if verdict is PlanVerdict.ACCEPTED and self.ctx.emergency:

@@ -16,6 +16,7 @@ from collections.abc import Callable
 
 from linecrew.bus import Bus
 from onboard_agent.agent import Agent
+from onboard_agent.mission import PlanVerdict
 from proto.errors import LinecrewError
 from proto.keys import KeySpace, Role, UavTopic
 from proto.plan import Plan
@@ -89,7 +90,8 @@ class Comms:
         async with self.bus.subscribe_async(self.keys.traffic(), TrafficReport) as sub:
             async for _key, report in sub:
                 self.agent.ctx.traffic.update(report, self.agent.ctx.link_clock())
-                self.agent.announce(report.generation, report.epoch)
+                if self.agent.announce(report.generation, report.epoch) is PlanVerdict.ACCEPTED:
+                    self.on_plan()  # a held plan now covered: act on it at once
 
     async def _ground_stations(self) -> None:
         key = self.keys.all_alive(Role.GROUND_STATION)

@@ -91,3 +91,27 @@ def test_comms_round_trip(bus_config):
             token.close()
 
     asyncio.run(main())
+
+
+def test_a_held_plan_wakes_the_tick_loop_when_an_announcement_covers_it(bus_config):
+    """A restarted agent holds a plan far ahead of any announced epoch; the
+    traffic report announcing it adopts it and wakes the tick loop at once."""
+    rig = Rig(gs_alive=False)
+    wakes: list[int] = []
+
+    async def main() -> None:
+        with Bus.open(bus_config) as agent_bus, Bus.open(bus_config) as gs_bus:
+            comms = Comms(
+                agent_bus, KEYS, rig.agent, on_plan=lambda: wakes.append(rig.mission.epoch)
+            )
+            running = asyncio.create_task(comms.run())
+            await until(lambda: gs_bus.alive(KEYS.alive(Role.AGENT, "uav-1")), what="agent token")
+            gs_bus.publish(KEYS.plan("uav-1"), plan(inspect_task("far"), epoch=500))
+            await until(lambda: wakes, what="the plan offered")
+            assert rig.mission.epoch != 500  # held: nothing announced yet
+            gs_bus.publish(KEYS.traffic(), Traffic(uavs=[], generation="gs-a", epoch=500))
+            await until(lambda: rig.mission.epoch == 500, what="adopted on announcement")
+            await until(lambda: wakes[-1] == 500, what="tick loop woken for it")
+            running.cancel()
+
+    asyncio.run(main())
