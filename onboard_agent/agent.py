@@ -141,13 +141,18 @@ class Agent:
             return AgentState.RECHARGING, ""
         why = self.not_ready()
         self._ready_once |= not why
+        if not why:
+            self.mission.arming_refused = False
         if why:
-            # not ready to fly at all (the autopilot's start-up) until first ready; a
-            # refusal after that (a low battery on the pad) is a passing one: the
+            # not ready to fly at all until first ready (the autopilot's start-up), or
+            # once a task gave up on arming (motors failed on the pad): its work goes
+            # to others until the autopilot can arm again; a refusal short of that (a
+            # low battery on the pad, which a recharge cures) is a passing one: the
             # state stays and ``ready`` says it, as arming retries and outcomes do
             state = AgentState.IDLE if self.mission.head is None else AgentState.BUSY
-            booting = ctx.config.not_ready_state and not self._ready_once
-            return (AgentState.NOT_READY if booting else state), why
+            refusing = not self._ready_once or self.mission.arming_refused
+            not_ready = ctx.config.not_ready_state and refusing
+            return (AgentState.NOT_READY if not_ready else state), why
         if self.mission.head is None:
             return AgentState.IDLE, ""
         return AgentState.BUSY, ""

@@ -28,6 +28,8 @@ EPOCH_LEAD = 100
 announced one (``Traffic.epoch``) and still be adopted at once: replans in
 the half second between announcements. A farther one waits for an
 announcement that covers it (a forged epoch never gets one)."""
+ARMING_REFUSALS = frozenset({"arm_refused", "takeoff_refused", "not_ready"})
+"""Failure codes of a task that gave up on the autopilot arming (after its retries)."""
 
 
 class PlanVerdict(enum.StrEnum):
@@ -50,6 +52,7 @@ class Mission:
         self.generation: str | None = None  # the ground station's run, as announced
         self.announced = 0  # the newest epoch that ground station has announced
         self._unannounced: Plan | None = None  # ahead of every announcement: held
+        self.arming_refused = False  # a task gave up on arming; the agent clears it when ready
         self.tasks: collections.deque[Task] = collections.deque()
         self.outbox: list[TaskOutcome] = []
         self._sent: collections.deque[TaskOutcome] = collections.deque(maxlen=16)
@@ -176,6 +179,7 @@ class Mission:
         """``task`` (the head) failed: report it and move on. ``retryable``:
         for a passing reason (it may succeed later or on another UAV)."""
         self._pop(task)
+        self.arming_refused |= code in ARMING_REFUSALS
         self._report(task, OutcomeResult.FAILED, reason, code=code, retryable=retryable)
 
     def abandon(self, reason: str) -> int:

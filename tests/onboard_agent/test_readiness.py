@@ -22,7 +22,7 @@ from tests.onboard_agent.conftest import (
     start_fleet,
     until,
 )
-from tests.onboard_agent.helpers import inspect_task, plan
+from tests.onboard_agent.helpers import Rig, inspect_task, plan
 
 SCENARIO = fast_scenario()
 SITE = SCENARIO.site
@@ -168,3 +168,24 @@ def test_with_the_state_off_not_ready_is_reported_as_idle_or_busy_with_ready_fal
     assert (idle.state, idle.ready) == (AgentState.IDLE, False)
     assert (busy.state, busy.ready) == (AgentState.BUSY, False)
     assert busy.reason.startswith("not ready: ")
+
+
+def test_a_uav_that_gave_up_arming_is_not_ready_until_its_autopilot_can_arm_again():
+    """Motors failed on the pad: the task gives up on arming, and the UAV's work
+    must go to others, not come back to it at every replan."""
+    rig = Rig()
+    rig.tick()
+    assert rig.agent.state() == (AgentState.IDLE, "")  # ready once
+    rig.autopilot.update(prearm_ok=False, arm_text="PreArm: Motors: check failed")
+    rig.agent.offer_plan(plan(inspect_task()))
+    assert rig.agent.state()[0] is AgentState.BUSY  # a refusal is passing at first
+    rig.run_until(lambda: rig.mission.head is None, max_ticks=2000)  # ready_timeout_s
+    [outcome] = rig.outcomes()
+    assert outcome.retryable and outcome.reason_code == "not_ready"
+    state, why = rig.agent.state()
+    assert state is AgentState.NOT_READY and "Motors" in why
+    assert not rig.agent.status().ready
+    rig.autopilot.update(prearm_ok=True, arm_text="")
+    assert rig.agent.state() == (AgentState.IDLE, "")
+    rig.autopilot.update(prearm_ok=False)  # a later passing refusal keeps the state
+    assert rig.agent.state()[0] is AgentState.IDLE
