@@ -7,11 +7,12 @@ times over a seeded stream of events (p50 / p99); and the quality
 makespan) of the plain paper heuristic, the complete heuristic and the
 complete heuristic + improvement. Every plan is validated.
 
-``--reference-ms`` adds a best-known plan per instance, the better of a long
-multi-seed improvement run and, with ``--reference cpsat``, OR-Tools CP-SAT
-(``reference``; the optional ``bench`` extra) on instances small enough for
-it, seeded with the planner's plan. Gaps are measured against the best plan
-seen.
+``--family`` picks instance families (``generator.FAMILIES``).
+``--reference-ms`` adds best-known plans per instance (``bench_reference``:
+long improvement runs from the planner and from the paper heuristic and,
+with ``--reference cpsat``, OR-Tools CP-SAT seeded from each, on instances
+small enough for it; the optional ``bench`` extra). Gaps are measured
+against the best plan seen, per instance and as mean / worst.
 """
 
 from __future__ import annotations
@@ -26,7 +27,8 @@ from typing import Any
 import msgspec
 
 from ground_station.planner.api import plan, score
-from ground_station.planner.generator import generate, ring_bearing
+from ground_station.planner.bench_reference import best_known, deadline, references
+from ground_station.planner.generator import FAMILIES, generate, ring_bearing
 from ground_station.planner.model import DeliverAction, MonitorAction, Problem
 from ground_station.planner.replan import (
     ActionAdded,
@@ -44,11 +46,6 @@ from ground_station.planner.routes import Options
 from ground_station.planner.validate import validate
 
 DEFAULT_SIZES = ("3x4", "5x20", "10x50", "20x200", "50x500")
-
-
-def _deadline(ms: float) -> Callable[[], bool]:
-    end = time.perf_counter() + ms / 1000.0
-    return lambda: time.perf_counter() >= end
 
 
 def calibration_ms() -> float:
@@ -161,17 +158,18 @@ def _pct(xs: list[float], q: float) -> float:
     return xs[min(len(xs) - 1, round(q * (len(xs) - 1)))]
 
 
-def run_case(n: int, m: int, seed: int, args: argparse.Namespace) -> dict[str, Any]:
-    problem = generate(n, m, seed)
+def run_case(family: str, n: int, m: int, seed: int, args: argparse.Namespace) -> dict[str, Any]:
+    problem = generate(n, m, seed, family)
     calib = calibration_ms()
     paper, paper_ms = _timed(lambda: plan(problem, Options(mode="paper")))
     complete, plan_ms = _timed(lambda: plan(problem))
     for _ in range(args.repeat - 1):  # minimum over repeats filters machine noise
         plan_ms = min(plan_ms, _timed(lambda: plan(problem))[1])
-    improved, improved_ms = _timed(lambda: plan(problem, should_stop=_deadline(args.improve_ms)))
+    improved, improved_ms = _timed(lambda: plan(problem, should_stop=deadline(args.improve_ms)))
     violations = sum(len(validate(problem, p)) for p in (paper, complete, improved))
     times, rv = replan_times(problem, m, args.events, seed, args.repeat)
     row: dict[str, Any] = {
+        "family": family,
         "size": f"{n}x{m}",
         "seed": seed,
         "calibration_ms": calib,
@@ -187,44 +185,34 @@ def run_case(n: int, m: int, seed: int, args: argparse.Namespace) -> dict[str, A
         "improved": _quality(improved),
     }
     if args.reference_ms > 0:
-        row.update(reference(problem, improved, args))
-        row["violations"] += len(validate(problem, row.pop("reference_plan")))
+        plans, info = references(
+            problem, improved, paper, args.reference_ms, args.reference == "cpsat"
+        )
+        best = best_known(plans, info)
+        row["violations"] += sum(len(validate(problem, p)) for p in plans.values())
+        row["references"] = {k: _quality(p) for k, p in plans.items()}
+        row["cpsat"] = info
+        row["reference"] = _quality(best.pop("plan"))
+        row["reference_kind"], row["optimum"] = best["kind"], best["optimum"]
+        row["proven"] = best["optimum"] is not None
+        row["bound"] = best["bound"]
     return row
 
 
-def reference(problem: Problem, improved: Plan, args: argparse.Namespace) -> dict[str, Any]:
-    """The best-known plan's quality (and the CP-SAT status and bound)."""
-    out: dict[str, Any] = {}
-    cpsat = None
-    if args.reference == "cpsat":
-        from ground_station.planner.reference import solve
-
-        r = solve(problem, args.reference_ms / 1000.0, hint=improved)
-        out["cpsat_status"] = r.status
-        out["cpsat_bound"] = r.score_bound
-        cpsat = r.plan
-    searched = min(
-        (plan(problem, should_stop=_deadline(args.reference_ms / 3), seed=k) for k in range(3)),
-        key=score,
-    )
-    best = searched if cpsat is None or score(searched) <= score(cpsat) else cpsat
-    out["reference"] = _quality(best)
-    out["reference_plan"] = best
-    return out
-
-
 def _gap(row: dict[str, Any], key: str) -> float:
-    ref = row.get("reference", row["improved"])["score"]
-    best = min(ref, row["improved"]["score"], row["paper"]["score"], row["complete"]["score"])
+    """``key``'s score above the best plan seen for the instance (%)."""
+    seen = [row[k] for k in ("paper", "complete", "improved", "reference") if k in row]
+    best = min(seen, key=lambda q: (q["unplaced"], q["score"]))["score"]
     return (row[key]["score"] / best - 1.0) * 100.0 if best > 0 else 0.0
 
 
 def summarise(rows: list[dict[str, Any]]) -> list[dict[str, Any]]:
     out = []
-    for size in dict.fromkeys(r["size"] for r in rows):
-        rs = [r for r in rows if r["size"] == size]
+    for family, size in dict.fromkeys((r["family"], r["size"]) for r in rows):
+        rs = [r for r in rows if (r["family"], r["size"]) == (family, size)]
         out.append(
             {
+                "family": family,
                 "size": size,
                 "seeds": len(rs),
                 "plan_ms_median": statistics.median(r["plan_ms"] for r in rs),
@@ -239,6 +227,14 @@ def summarise(rows: list[dict[str, Any]]) -> list[dict[str, Any]]:
                 "gap_complete_pct": statistics.mean(_gap(r, "complete") for r in rs),
                 "gap_improved_pct": statistics.mean(_gap(r, "improved") for r in rs),
                 "gap_improved_worst_pct": max(_gap(r, "improved") for r in rs),
+                "unplaced_improved": sum(r["improved"]["unplaced"] for r in rs),
+                "reference_kinds": sorted({r.get("reference_kind", "-") for r in rs}),
+                "proven": sum(bool(r.get("proven")) for r in rs),
+                "gap_to_optimum_pct": [
+                    (r["improved"]["score"] / r["optimum"] - 1.0) * 100.0
+                    for r in rs
+                    if r.get("optimum")
+                ],
                 "improved_not_worse_than_paper": all(
                     (r["improved"]["unplaced"], r["improved"]["score"])
                     <= (r["paper"]["unplaced"], r["paper"]["score"])
@@ -254,19 +250,22 @@ def main(argv: list[str]) -> int:
     parser.add_argument("target", nargs="?", default="planner", choices=("planner",))
     parser.add_argument("--sizes", nargs="+", default=list(DEFAULT_SIZES), help="UAVSxACTIONS")
     parser.add_argument("--seeds", nargs="+", type=int, default=[0, 1, 2])
+    parser.add_argument(
+        "--family", nargs="+", default=["corridor"], choices=sorted(FAMILIES), help="instances"
+    )
     parser.add_argument("--improve-ms", type=float, default=1000.0)
     parser.add_argument("--events", type=int, default=100, help="replan events per instance")
     parser.add_argument(
         "--repeat", type=int, default=3, help="timing repeats (the minimum is reported)"
     )
     parser.add_argument(
-        "--reference-ms", type=float, default=0.0, help="best-known search budget per instance"
+        "--reference-ms", type=float, default=0.0, help="budget of each reference per instance"
     )
     parser.add_argument(
         "--reference",
         choices=("search", "cpsat"),
         default="search",
-        help="best-known by long search, or also by OR-Tools CP-SAT (small instances)",
+        help="best-known by long searches, or also by OR-Tools CP-SAT (small instances)",
     )
     parser.add_argument("--json", action="store_true", help="print JSON instead of tables")
     args = parser.parse_args(argv)
@@ -280,41 +279,105 @@ def main(argv: list[str]) -> int:
         except ImportError:
             parser.error("--reference cpsat needs OR-Tools: pip install 'linecrew[bench]'")
     calib = calibration_ms()
-    rows = [run_case(n, m, seed, args) for n, m in sizes for seed in args.seeds]
+    rows = [
+        run_case(f, n, m, seed, args) for f in args.family for n, m in sizes for seed in args.seeds
+    ]
     summary = summarise(rows)
+    ok = all(s["violations"] == 0 for s in summary)
     if args.json:
         doc = {"calibration_ms": calib, "summary": summary, "runs": rows}
         print(msgspec.json.format(msgspec.json.encode(doc)).decode())
-        return 0 if all(s["violations"] == 0 for s in summary) else 1
+        return 0 if ok else 1
+    _print_tables(rows, summary, calib, args.reference_ms > 0)
+    return 0 if ok else 1
+
+
+SUMMARY_COLS = (
+    ("family", "family", "{}"),
+    ("size", "size", "{}"),
+    ("plan", "plan_ms_median", "{:.0f}"),
+    ("max", "plan_ms_max", "{:.0f}"),
+    ("@100", "plan_ms_at_yardstick_100", "{:.0f}"),
+    ("rp50", "replan_p50_ms", "{:.1f}"),
+    ("rp99", "replan_p99_ms", "{:.1f}"),
+    ("paper%", "gap_paper_pct", "{:.1f}"),
+    ("cmpl%", "gap_complete_pct", "{:.1f}"),
+    ("impr%", "gap_improved_pct", "{:.1f}"),
+    ("worst%", "gap_improved_worst_pct", "{:.1f}"),
+    ("unpl", "unplaced_improved", "{:.0f}"),
+    ("reference", "reference_kinds", "{}"),
+    ("proven", "proven", "{}"),
+    ("viol", "violations", "{}"),
+)
+
+
+def _instance_row(r: dict[str, Any]) -> tuple[str, ...]:
+    proven = r["proven"]
+    ref_gap = _gap(r, "reference")
+    return (
+        r["family"],
+        r["size"],
+        str(r["seed"]),
+        f"{_gap(r, 'paper'):.1f}",
+        f"{_gap(r, 'improved'):.1f}",
+        f"{ref_gap:.1f}",
+        r["reference_kind"],
+        "proven" if proven else "best-known",
+        f"{(r['improved']['score'] / r['optimum'] - 1) * 100:.1f}" if proven else "",
+        f"{r['bound']:.0f}" if r["bound"] else "",
+    )
+
+
+def _print_tables(
+    rows: list[dict[str, Any]], summary: list[dict[str, Any]], calib: float, refs: bool
+) -> None:
     from rich.console import Console
     from rich.table import Table
 
+    console = Console()
+    if not console.is_terminal:
+        console.width = max(console.width, 160)
+    if refs:
+        per = Table(title="per instance")
+        per.caption = (
+            "paper/impr/ref%: score above the best plan seen (impr: after --improve-ms); "
+            "reference: the best reference (search, paper-search, cpsat-planner, "
+            "cpsat-paper); proven: CP-SAT proved the optimum of its (restricted) model; "
+            "vs opt%: planner above that optimum (negative: the planner found a plan "
+            "outside the model); bound: CP-SAT lower bound on the score"
+        )
+        for title in (
+            "family",
+            "size",
+            "seed",
+            "paper%",
+            "impr%",
+            "ref%",
+            "reference",
+            "kind",
+            "vs opt%",
+            "bound",
+        ):
+            per.add_column(title, justify="right")
+        for r in rows:
+            per.add_row(*_instance_row(r))
+        console.print(per)
     table = Table(title="linecrew planner bench")
     table.caption = (
         "plan/max: full plan ms (median/max over seeds); @100: plan ms scaled to a "
         "100 ms yardstick; rp50/rp99: one-event replan ms; paper/cmpl/impr%: score "
-        "above the best plan seen (worst: worst seed); viol: validator violations"
+        "above the best plan seen, mean (worst: worst seed); unpl: unplaced parts after "
+        "improvement; proven: seeds with a CP-SAT optimum; viol: validator violations"
     )
-    cols = (
-        ("size", "size", "{}"),
-        ("plan", "plan_ms_median", "{:.0f}"),
-        ("max", "plan_ms_max", "{:.0f}"),
-        ("@100", "plan_ms_at_yardstick_100", "{:.0f}"),
-        ("rp50", "replan_p50_ms", "{:.1f}"),
-        ("rp99", "replan_p99_ms", "{:.1f}"),
-        ("paper%", "gap_paper_pct", "{:.1f}"),
-        ("cmpl%", "gap_complete_pct", "{:.1f}"),
-        ("impr%", "gap_improved_pct", "{:.1f}"),
-        ("worst%", "gap_improved_worst_pct", "{:.1f}"),
-        ("viol", "violations", "{}"),
-    )
-    for title, _, _ in cols:
+    for title, _, _ in SUMMARY_COLS:
         table.add_column(title, justify="right")
     for s in summary:
-        table.add_row(*(fmt.format(s[key]) for _, key, fmt in cols))
-    console = Console()
+        table.add_row(*(_cell(s[key], fmt) for _, key, fmt in SUMMARY_COLS))
     console.print(table)
     console.print(f"CPU yardstick (fixed 2M-step Python loop): {calib:.0f} ms")
-    if args.reference_ms <= 0:
+    if not refs:
         console.print("reference: none (use --reference-ms, and --reference cpsat, for best-known)")
-    return 0 if all(s["violations"] == 0 for s in summary) else 1
+
+
+def _cell(value: Any, fmt: str) -> str:
+    return ",".join(value) if isinstance(value, list) else fmt.format(value)

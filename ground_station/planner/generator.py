@@ -6,10 +6,17 @@ pads), tool stations, a mix of physical / inspection / safety UAVs on small
 batteries (about 12-15 min of flight, so long jobs force recharges and
 monitoring forces hand-overs), and a mix of actions around the towers.
 Same arguments, same problem.
+
+Families (``FAMILIES``) stress one shape each: ``corridor`` (the mix above),
+``long`` (the work starts 15 km from the homes, 1.5 to 2.3 full batteries
+out), ``charge`` (charging stations only, one pad each, slow:
+partial charges matter), ``monitors`` (k = 2-3 monitors lasting 20-30 min,
+more than a battery) and ``tools`` (mostly deliveries, one gripper UAV).
 """
 
 from __future__ import annotations
 
+import dataclasses
 import itertools
 import random
 from collections.abc import Iterable
@@ -72,12 +79,55 @@ def ring_bearing(actions: Iterable[Action], worker_m: Vec3) -> float:
     return next(RING_TURN_DEG * i for i in itertools.count() if RING_TURN_DEG * i not in taken)
 
 
-def generate(n_uavs: int, n_actions: int, seed: int = 0) -> Problem:
-    """A corridor problem with ``n_uavs`` UAVs and ``n_actions`` actions."""
+@dataclasses.dataclass(frozen=True)
+class Family:
+    """Knobs of one instance family (the defaults are ``corridor``)."""
+
+    lead_m: float = 0.0
+    """Empty line before the first tower (stations along it too)."""
+    homes_at_start: bool = False
+    """Every UAV's home is the first station (else spread along the line)."""
+    swap_share: float = 0.4
+    pads: tuple[int, int] = (1, 3)
+    full_charge_s: tuple[float, ...] = (900.0, 1200.0)
+    mix: tuple[float, float] = (0.5, 0.8)
+    """Action kinds: inspect below the first, monitor below the second,
+    else deliver."""
+    k: tuple[int, ...] = (1, 1, 2, 2, 3)
+    """Monitoring UAVs per watch (1 below 6 UAVs unless ``k_always``: then
+    at most a third of the fleet)."""
+    k_always: bool = False
+    durations_s: tuple[float, ...] = (300, 600, 900, 1200)
+    one_gripper: bool = False
+    """Only the first UAV can deliver (the others inspect or watch)."""
+
+
+FAMILIES = {
+    "corridor": Family(),
+    "long": Family(lead_m=15000.0, homes_at_start=True),
+    "charge": Family(swap_share=0.0, pads=(1, 1), full_charge_s=(1200.0, 1800.0)),
+    "monitors": Family(
+        swap_share=0.8, mix=(0.3, 0.9), k=(2, 3), k_always=True, durations_s=(1200, 1800)
+    ),
+    "tools": Family(mix=(0.2, 0.35), one_gripper=True),
+}
+
+
+def _k(fam: Family, rng: random.Random, n_uavs: int) -> int:
+    """Monitoring UAVs for one watch: at most a third of the fleet when every
+    watch has several (each slot needs reliefs)."""
+    if fam.k_always:
+        return min(rng.choice(fam.k), max(1, n_uavs // 3))
+    return rng.choice(fam.k) if n_uavs >= 6 else 1
+
+
+def generate(n_uavs: int, n_actions: int, seed: int = 0, family: str = "corridor") -> Problem:
+    """A problem of ``family`` with ``n_uavs`` UAVs and ``n_actions`` actions."""
+    fam = FAMILIES[family]
     rng = random.Random(seed * 1_000_003 + n_uavs * 1009 + n_actions)
     n_towers = max(8, n_actions // 3 + 4, n_uavs * 2)
     towers = []
-    x = 0.0
+    x = fam.lead_m
     for i in range(n_towers):
         x += rng.uniform(250.0, 350.0)
         towers.append((x, 120.0 * sin(i / 7.0), rng.uniform(25.0, 40.0)))
@@ -87,15 +137,15 @@ def generate(n_uavs: int, n_actions: int, seed: int = 0) -> Problem:
     for i in range(n_st):
         sx = length * i / (n_st - 1)
         side = 80.0 if i % 2 else -80.0
-        swap = rng.random() < 0.4
+        swap = rng.random() < fam.swap_share
         stations.append(
             Station(
                 id=f"S{i}",
                 position_m=(round(sx, 1), round(120.0 * sin(sx / 300.0 / 7.0) + side, 1), 0.0),
-                pads=rng.randint(1, 3),
+                pads=rng.randint(*fam.pads),
                 recharge="swap" if swap else "charge",
                 swap_s=90.0,
-                full_charge_s=rng.choice((900.0, 1200.0)),
+                full_charge_s=rng.choice(fam.full_charge_s),
             )
         )
     tool_stations = [
@@ -108,8 +158,8 @@ def generate(n_uavs: int, n_actions: int, seed: int = 0) -> Problem:
     ]
     uavs = []
     for i in range(n_uavs):
-        utype = TYPES[i % 3]
-        st = stations[(i * 7) % n_st]
+        utype = TYPES[(i % 2 + 1 if i else 0) if fam.one_gripper else i % 3]
+        st = stations[0 if fam.homes_at_start else (i * 7) % n_st]
         uavs.append(
             Uav(
                 id=f"U{i:02d}",
@@ -125,7 +175,7 @@ def generate(n_uavs: int, n_actions: int, seed: int = 0) -> Problem:
         weight = float(rng.randint(1, 5))
         release = 0.0 if rng.random() < 0.7 else round(rng.uniform(0.0, 1800.0), 1)
         centre = rng.randrange(n_towers)
-        if r < 0.5:
+        if r < fam.mix[0]:
             n_wp = rng.randint(3, min(10, n_towers))
             start = max(0, min(centre, n_towers - n_wp))
             wps = tuple(
@@ -142,7 +192,7 @@ def generate(n_uavs: int, n_actions: int, seed: int = 0) -> Problem:
             actions.append(
                 InspectAction(id=f"A{i:03d}", weight=weight, release_s=release, waypoints=wps)
             )
-        elif r < 0.8:
+        elif r < fam.mix[1]:
             tx, ty, tz = towers[centre]
             actions.append(
                 MonitorAction(
@@ -151,9 +201,9 @@ def generate(n_uavs: int, n_actions: int, seed: int = 0) -> Problem:
                     weight=weight,
                     release_s=release,
                     worker_m=(tx, ty, tz - 5.0),
-                    k=rng.choice((1, 1, 2, 2, 3)) if n_uavs >= 6 else 1,
+                    k=_k(fam, rng, n_uavs),
                     standoff_m=10.0,
-                    duration_s=float(rng.choice((300, 600, 900, 1200))),
+                    duration_s=float(rng.choice(fam.durations_s)),
                 )
             )
         else:

@@ -7,6 +7,8 @@ Each slot is covered by a chain of segments: when a UAV's battery forces it
 to leave, another UAV arrives at or before that moment and takes the slot
 (the paper's Fig. 6), so coverage has no gap. Segments are tasks anchored
 at their start time; the UAV that left recharges in its own route.
+An action some of whose segments stay planned (an improvement ruins the
+rest but never moves a frozen one) gets only its slots without one.
 """
 
 from __future__ import annotations
@@ -17,11 +19,10 @@ from math import dist
 from ground_station.planner import costs
 from ground_station.planner.energy import EPS_S
 from ground_station.planner.model import MonitorAction, Vec3, slot_position
+from ground_station.planner.monitor_start import ReadyTimes, start_times
 from ground_station.planner.routes import Ctx
 from ground_station.planner.simulate import Task, monitor_reach
 
-MAX_T0_CANDIDATES = 2
-"""Start times tried (the k-th earliest arrival, then later arrivals)."""
 MAX_REACH = 3
 """UAVs (best first by suitability and distance) examined for each segment."""
 MON_TRAVEL = 1.0
@@ -35,14 +36,14 @@ uniform random fraction in this range of its reach), so a UAV can leave
 early for other work."""
 SHUFFLE_P = 0.2
 """Improvement only: the chance that segment candidates are tried in random order."""
-RANDOM_T0 = 2
-"""Improvement only: random start times added to the candidates."""
 
 
-def _cover(ctx: Ctx, a: MonitorAction, t0: float, uids: list[str]) -> float | None:
+def _cover(
+    ctx: Ctx, a: MonitorAction, t0: float, uids: list[str], ready: dict[str, float] | None = None
+) -> float | None:
     """Tentatively commit a full coverage from ``t0``; its cost, or None."""
     end = t0 + a.duration_s
-    return _cover_needs(ctx, a, [(t0, s, end) for s in range(a.k)], uids)
+    return _cover_needs(ctx, a, [(t0, s, end) for s in range(a.k)], uids, ready=ready)
 
 
 def _push_position(ctx: Ctx, uid: str, pos: Vec3, t: float) -> int | None:
@@ -89,9 +90,12 @@ def _cover_needs(
     needs: list[tuple[float, int, float]],
     uids: list[str],
     push: bool = False,
+    ready: dict[str, float] | None = None,
 ) -> float | None:
     """Commit segments covering each (from, slot, until) with hand-overs.
-    With ``push`` a segment may also go before a UAV's later tasks."""
+    With ``push`` a segment may also go before a UAV's later tasks.
+    ``ready`` (lower bounds of the UAVs' ready times, ``ReadyTimes.bound``)
+    skips UAVs that cannot be at a slot by then, until they take a segment."""
     min_seg = ctx.problem.min_monitor_segment_s
     slots = [slot_position(a, s) for s in range(a.k)]
     need = list(needs)
@@ -105,6 +109,8 @@ def _cover_needs(
         fleet.append((uid, w.suitability_s * suit + w.interruption_s * jv, suit))
     suit_sum = 0.0
     handovers = 0
+    moved: set[str] = set()
+    inf = float("inf")
     while need:
         t, s, end = heapq.heappop(need)
         pos = slots[s]
@@ -114,6 +120,9 @@ def _cover_needs(
             if len(ranked) >= MAX_REACH:
                 break
             r = ctx.routes[uid]
+            slack = 2 * a.standoff_m / r.kin.speed_mps + EPS_S  # slot 0 to slot s
+            if ready is not None and uid not in moved and ready.get(uid, inf) > t + slack:
+                continue
             st = r.state_before(p)
             reach = monitor_reach(r.kin, ctx.site, ctx.pads, st, pos, t, (uid, st.t), end)
             if reach is None:
@@ -133,6 +142,7 @@ def _cover_needs(
             if isinstance(sim, str):
                 continue
             ctx.commit(uid, p, [task], sim)
+            moved.add(uid)
             suit_sum += suit * (seg_end - t) / a.duration_s
             if seg_end < end - EPS_S:
                 heapq.heappush(need, (seg_end, s, end))
@@ -164,6 +174,29 @@ def _keep_start(ctx: Ctx, a: MonitorAction, uids: list[str]) -> bool:
     return False
 
 
+def _complete_kept(ctx: Ctx, a: MonitorAction, uids: list[str]) -> bool:
+    """If segments of ``a`` are still planned (pinned ones an improvement
+    round kept), cover only the slots without one over the kept segments'
+    window, never a second coverage beside them; True if so (unplaced if
+    that is impossible)."""
+    kept = [
+        (t.anchor_s, t.anchor_s + t.service_s, t.index)
+        for uid in ctx.placed_uavs(a.id)
+        for t in ctx.routes[uid].tasks
+        if t.action_id == a.id and t.anchor_s is not None
+    ]
+    if not kept:
+        return False
+    start, end = min(k[0] for k in kept), max(k[1] for k in kept)
+    needs = [(start, s, end) for s in range(a.k) if s not in {k[2] for k in kept}]
+    if needs:
+        snap = ctx.snapshot()
+        if _cover_needs(ctx, a, needs, uids) is None:
+            ctx.restore(snap)
+            ctx.add_unplaced(a.id, None, "monitor_coverage_infeasible")
+    return True
+
+
 def place_monitor(ctx: Ctx, a: MonitorAction) -> None:
     uids = ctx.capable("monitor")
     if not uids:
@@ -171,6 +204,8 @@ def place_monitor(ctx: Ctx, a: MonitorAction) -> None:
         return
     if a.k > len(uids):
         ctx.add_unplaced(a.id, None, "k_exceeds_fleet")
+        return
+    if _complete_kept(ctx, a, uids):
         return
     pos0 = slot_position(a, 0)
     d = ctx.site.nearest(pos0)[0]
@@ -185,26 +220,12 @@ def place_monitor(ctx: Ctx, a: MonitorAction) -> None:
     base = max(a.release_s, ctx.problem.now_s)
     if a.start_s is not None and a.start_s >= base and _keep_start(ctx, a, uids):
         return
-    arrivals = sorted(
-        max(base, r.tail().t + dist(r.tail().pos, pos0) / r.kin.speed_mps)
-        for r in (ctx.routes[u] for u in uids)
-    )
-    t0 = arrivals[a.k - 1]
-    horizon = ctx.weights.suitability_s
-    primary = [t0, *[x for x in arrivals[a.k :] if t0 < x <= t0 + horizon]][:MAX_T0_CANDIDATES]
-    if ctx.fast:
-        primary = primary[:2]
-    if ctx.options.mode == "paper":
-        primary = primary[:1]
-    fallback = [arrivals[j] for j in (a.k, a.k + 1, a.k + 3, a.k + 7) if j < len(arrivals)]
-    charge_s = max((s.full_charge_s for s in ctx.site.charging), default=0.0)
-    last = arrivals[-1]
-    fallback += [last, last + a.duration_s, last + charge_s, last + 2 * (a.duration_s + charge_s)]
-    if ctx.fast:
-        fallback = [*fallback[:1], last + a.duration_s, last + 2 * (a.duration_s + charge_s)]
-    if ctx.rng is not None:
-        span = last + a.duration_s - base
-        primary += [base + ctx.rng.random() * span for _ in range(RANDOM_T0)]
+    ready = ReadyTimes(ctx, a, uids, base, min_seg)
+    t0 = ready.nth(a.k - 1)
+    if t0 is None:
+        ctx.add_unplaced(a.id, None, "monitor_coverage_infeasible")
+        return
+    primary, fallback = start_times(ctx, a, ready, t0)
     snap = ctx.snapshot()
     best: tuple[float, tuple] | None = None
     tried: set[float] = set()
@@ -213,7 +234,7 @@ def place_monitor(ctx: Ctx, a: MonitorAction) -> None:
             if t in tried:
                 continue
             tried.add(t)
-            cost = _cover(ctx, a, t, uids)
+            cost = _cover(ctx, a, t, uids, ready.bound)
             if cost is not None and (best is None or cost < best[0]):
                 best = (cost, ctx.snapshot())
             ctx.restore(snap)

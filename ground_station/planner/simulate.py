@@ -13,13 +13,24 @@ from __future__ import annotations
 
 from math import dist
 
-from ground_station.planner.energy import EPS_S, EPS_WH, Kin, Site
+from ground_station.planner.energy import EPS_S, EPS_WH, Kin, Site, recharge_time_s
 from ground_station.planner.model import Vec3
 from ground_station.planner.pads import Ignore, Pads
 from ground_station.planner.recharge import emit_recharge, next_hop, recharge_option
 from ground_station.planner.state import Fail, Sim, State, Task
 
-__all__ = ["Fail", "Sim", "State", "Task", "advance", "monitor_reach", "simulate"]
+__all__ = [
+    "Fail",
+    "Sim",
+    "State",
+    "Task",
+    "advance",
+    "direct_arrival",
+    "hold_floor_wh",
+    "monitor_reach",
+    "monitor_ready",
+    "simulate",
+]
 
 MAX_HOPS = 12
 LONG_WAIT_S = 120.0
@@ -229,15 +240,79 @@ def monitor_reach(
         best = _reach_once(k, site, pads, st, pos, anchor, ign, need)
         if best is not None:
             return best
-        si = next_hop(k, site, st, pos)
-        if si is None:
+        hopped = _hop(k, site, pads, st, pos, ign, anchor)
+        if hopped is None:
             return None
-        hop = recharge_option(k, site, pads, st, site.positions[si], 0.0, None, ign, None, si)
-        if hop is None:
-            return None
-        t_pad = st.t + site.dists(st.pos)[si] / k.speed_mps + hop.wait_s
-        st = State(t_pad + hop.dur_s, site.positions[si], hop.e_charged, True, st.tool)
+        st = hopped
     return None
+
+
+def monitor_ready(
+    k: Kin,
+    site: Site,
+    pads: Pads,
+    st: State,
+    pos: Vec3,
+    release_s: float,
+    ign: Ignore,
+    hold_s: float,
+) -> float | None:
+    """Earliest time (not before ``release_s``) the UAV in ``st`` can be at
+    ``pos`` with the battery to hover there ``hold_s`` and still reach a
+    station above the reserve: directly, after a recharge first, or after
+    hops along stations; None if it cannot get there."""
+    floor = hold_floor_wh(k, site, pos, hold_s)
+    for _ in range(MAX_HOPS + 1):
+        arr, e_at = direct_arrival(k, st, pos, release_s)
+        if e_at >= floor:
+            return arr
+        rc = recharge_option(k, site, pads, st, pos, release_s, None, ign)
+        if rc is None or rc.e_at_task < floor:  # the earliest is short: the nearest station
+            near = site.nearest(pos)[1]
+            rc = recharge_option(k, site, pads, st, pos, release_s, None, ign, None, near)
+        if rc is not None and rc.e_at_task >= floor:
+            return rc.arrive_task
+        hopped = _hop(k, site, pads, st, pos, ign)
+        if hopped is None:
+            return None
+        st = hopped
+    return None
+
+
+def direct_arrival(k: Kin, st: State, pos: Vec3, release_s: float) -> tuple[float, float]:
+    """(arrival, energy there) flying straight from ``st`` to ``pos``, not
+    arriving before ``release_s`` (an airborne UAV hovers while it waits)."""
+    tr = dist(st.pos, pos) / k.speed_mps
+    arr = max(release_s, st.t + tr)
+    e_wait = st.e if st.landed else st.e - k.hover_whps * (arr - tr - st.t)
+    return arr, e_wait - tr * k.speed_mps * k.wh_per_m
+
+
+def hold_floor_wh(k: Kin, site: Site, pos: Vec3, hold_s: float) -> float:
+    """Battery needed at ``pos`` to hover ``hold_s`` there and then reach the
+    nearest station above the reserve."""
+    return k.reserve_wh - EPS_WH + site.nearest(pos)[0] * k.wh_per_m + k.hover_whps * hold_s
+
+
+def _hop(
+    k: Kin, site: Site, pads: Pads, st: State, pos: Vec3, ign: Ignore, latest: float | None = None
+) -> State | None:
+    """The state on the pad after a recharge at the next station towards
+    ``pos`` (``next_hop``), as ``advance`` would fly it; None if there is
+    none, or if through it the UAV cannot be at ``pos`` by ``latest``."""
+    si = next_hop(k, site, st, pos)
+    if si is None:
+        return None
+    d1 = site.dists(st.pos)[si]
+    if latest is not None:
+        charge_s = recharge_time_s(site.charging[si], k.capacity_wh, st.e - d1 * k.wh_per_m)
+        if st.t + (d1 + site.dists(pos)[si]) / k.speed_mps + charge_s > latest + EPS_S:
+            return None
+    hop = recharge_option(k, site, pads, st, site.positions[si], 0.0, None, ign, None, si)
+    if hop is None:
+        return None
+    t_pad = st.t + d1 / k.speed_mps + hop.wait_s
+    return State(t_pad + hop.dur_s, site.positions[si], hop.e_charged, True, st.tool)
 
 
 def _reach_once(

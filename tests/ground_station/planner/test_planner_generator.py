@@ -1,0 +1,59 @@
+"""Instance families of the bench generator: each has the shape it names,
+and the planner's plans for them validate."""
+
+from __future__ import annotations
+
+from math import dist
+
+import pytest
+
+from ground_station.planner import DeliverAction, MonitorAction, plan, validate
+from ground_station.planner.generator import FAMILIES, TYPES, generate
+
+
+def test_the_default_family_is_the_corridor() -> None:
+    assert generate(6, 12, 3) == generate(6, 12, 3, "corridor")
+    assert generate(6, 12, 3, "long") != generate(6, 12, 3)
+
+
+def test_long_corridors_put_the_work_several_charges_from_home() -> None:
+    problem = generate(3, 6, 0, "long")
+    home = problem.stations[0]
+    assert {u.home_station for u in problem.uavs} == {home.id}
+    nearest_work = min(
+        dist(home.position_m, w.position_m)
+        for a in problem.actions
+        for w in getattr(a, "waypoints", ())
+    )
+    ranges_m = [
+        t.battery_wh * (1 - problem.reserve_fraction) * 3600 / t.flight_power_w * t.cruise_speed_mps
+        for t in TYPES
+    ]  # 6.7 to 10.1 km on a full battery
+    assert nearest_work > 2 * min(ranges_m) and nearest_work > 1.4 * max(ranges_m)
+
+
+def test_charge_family_has_slow_single_pad_charging_only() -> None:
+    problem = generate(4, 12, 1, "charge")
+    assert all(s.recharge == "charge" and s.pads == 1 for s in problem.stations)
+    assert min(s.full_charge_s for s in problem.stations) >= 1200.0
+
+
+def test_monitor_family_watches_long_with_several_uavs() -> None:
+    problem = generate(10, 30, 0, "monitors")
+    watches = [a for a in problem.actions if isinstance(a, MonitorAction)]
+    assert len(watches) >= len(problem.actions) // 2
+    assert all(2 <= a.k <= 3 and a.duration_s >= 1200 for a in watches)
+
+
+def test_tools_family_has_one_gripper_for_many_deliveries() -> None:
+    problem = generate(6, 20, 0, "tools")
+    kinds = {t.id: t.capabilities for t in problem.uav_types}
+    grippers = [u for u in problem.uavs if "deliver" in kinds[u.type]]
+    assert len(grippers) == 1
+    assert sum(isinstance(a, DeliverAction) for a in problem.actions) >= len(problem.actions) // 2
+
+
+@pytest.mark.parametrize("family", sorted(FAMILIES))
+def test_plans_for_every_family_validate(family: str) -> None:
+    problem = generate(4, 12, 2, family)
+    assert validate(problem, plan(problem)) == []
