@@ -2,22 +2,29 @@
 
 Presence comes from each agent's liveliness token plus the freshness of its
 telemetry. A UAV silent (token gone, or no telemetry) for less than
-``link_timeout_s`` is still present: brief drop-outs cause nothing. Longer,
+``link_timeout_s`` is still present: brief drop-outs move no work. Longer,
 it is *lost* and its work goes to others; when token and telemetry return it
 is *back*. A UAV whose telemetry says it crashed, or whose agent says it
 failed, is reported at once, without the grace, and takes no work until it
 reports otherwise (then it is *back*). UAVs never heard since start-up begin
 as lost (without an event).
-A present UAV silent for ``SILENT_AFTER_S`` or more is shown as silent (with
-how long) until it is heard again or declared lost.
-Time is injected: :meth:`FleetMonitor.check` is called with the clock's now.
+A present UAV silent for ``SILENT_AFTER_S`` or more is *silent*: shown with
+how long and since when (mission time), its planned tasks unknown (never
+failed), until it is *heard* again or declared lost; :meth:`FleetMonitor.check`
+reports the start and the end of each such spell once.
+Time is injected: :meth:`FleetMonitor.check` and the ``on_*`` feeds get the
+watchdog's (monotonic) now; the mission clock, read as reports arrive, only
+dates the silences.
 """
 
 from __future__ import annotations
 
 import dataclasses
 import enum
+import time
+from collections.abc import Callable, Mapping
 
+from proto.plan import Plan
 from proto.rpc import UavOpState, UavState
 from proto.telemetry import (
     AgentState,
@@ -42,8 +49,9 @@ TRAFFIC_MAX_AGE_S = 60.0
 """UAVs last heard airborne longer ago than this are left out of the
 traffic (a hung UAV may hover on where it was for that long)."""
 AIRBORNE = frozenset({FlightState.TAKING_OFF, FlightState.FLYING, FlightState.LANDING})
-SILENT_AFTER_S = 1.0
-"""Silence (s) after which a present UAV is shown as silent: several telemetry periods."""
+SILENT_AFTER_S = 2.0
+"""Silence (s) after which a present UAV is silent: ten telemetry periods, and
+two status periods (an agent with no position yet is heard once a second)."""
 
 
 class Change(enum.StrEnum):
@@ -54,13 +62,18 @@ class Change(enum.StrEnum):
     CRASHED = "crashed"  # telemetry says crashed (or disarmed in the air): lost at once
     FAILED = "failed"  # the agent reports itself failed (e.g. no autopilot): lost at once
     NOT_READY = "not_ready"  # on its pad, the autopilot cannot arm yet: work goes elsewhere
+    SILENT = "silent"  # present, unheard for SILENT_AFTER_S: its tasks are unknown, nothing moves
+    HEARD = "heard"  # a silent UAV heard again before the link timeout
 
 
 @dataclasses.dataclass
 class _Uav:
     token: bool = False
     token_lost_s: float | None = None
+    token_lost_at: float | None = None  # ``token_lost_s`` on the mission clock
     heard_s: float | None = None  # last telemetry (or status)
+    heard_at: float | None = None  # ``heard_s`` on the mission clock
+    silent_since: float | None = None  # mission time a silent spell began (None: not silent)
     telemetry_s: float | None = None  # when ``telemetry`` arrived
     lost: bool = True
     lost_s: float | None = None
@@ -83,8 +96,14 @@ def _down(uav: _Uav) -> Change | None:
 class FleetMonitor:
     """Tracks every UAV of the fleet; feed it tokens, telemetry and status."""
 
-    def __init__(self, uav_ids: list[str], link_timeout_s: float) -> None:
+    def __init__(
+        self,
+        uav_ids: list[str],
+        link_timeout_s: float,
+        mission_clock: Callable[[], float] = time.time,
+    ) -> None:
         self.link_timeout_s = link_timeout_s
+        self.mission_clock = mission_clock
         self._uavs = {uav_id: _Uav() for uav_id in uav_ids}
         self._checked_s: float | None = None  # the clock at the last check
 
@@ -99,6 +118,7 @@ class FleetMonitor:
             return
         uav.token = alive
         uav.token_lost_s = None if alive else now_s
+        uav.token_lost_at = None if alive else self.mission_clock()
 
     def on_telemetry(self, telemetry: Telemetry, now_s: float) -> None:
         """A telemetry sample arrived (stamped with the receiver's clock)."""
@@ -106,6 +126,7 @@ class FleetMonitor:
         if uav is not None:
             uav.telemetry = telemetry
             uav.heard_s = uav.telemetry_s = now_s
+            uav.heard_at = self.mission_clock()
 
     def on_status(self, status: AgentStatus, now_s: float | None = None) -> None:
         """An agent status arrived (at ``now_s`` of the receiver's clock: the
@@ -114,7 +135,7 @@ class FleetMonitor:
         if uav is not None:
             uav.status = status
             if now_s is not None:
-                uav.heard_s = now_s
+                uav.heard_s, uav.heard_at = now_s, self.mission_clock()
 
     def silence_s(self, uav_id: str, now_s: float) -> float:
         """How long ``uav_id`` has been silent (``inf`` if never heard)."""
@@ -124,8 +145,13 @@ class FleetMonitor:
         token_silence = 0.0 if uav.token else now_s - (uav.token_lost_s or now_s)
         return max(token_silence, now_s - uav.heard_s)
 
+    def silent_since(self, uav_id: str) -> float | None:
+        """Mission time the silent spell of ``uav_id`` began (None: not silent)."""
+        return self._uavs[uav_id].silent_since
+
     def check(self, now_s: float) -> list[tuple[str, Change]]:
-        """Apply the timeout; return the UAVs that became lost or came back."""
+        """Apply the timeout; return the UAVs that became lost or came back,
+        and those that fell silent or were heard again meanwhile."""
         self._checked_s = now_s
         changes: list[tuple[str, Change]] = []
         for uav_id, uav in self._uavs.items():
@@ -139,13 +165,15 @@ class FleetMonitor:
                 changes.append((uav_id, Change.BACK))
             # a lost UAV's state is said once it is back (the next check)
             uav.down = None if uav.lost else down
-            silent = self.silence_s(uav_id, now_s) >= self.link_timeout_s
-            if silent and not uav.lost:
-                uav.lost, uav.lost_s = True, now_s
+            silence = self.silence_s(uav_id, now_s)
+            if silence >= self.link_timeout_s and not uav.lost:
+                uav.lost, uav.lost_s, uav.silent_since = True, now_s, None
                 changes.append((uav_id, Change.LOST))
-            elif uav.lost and uav.token and not silent:
+            elif uav.lost and uav.token and silence < self.link_timeout_s:
                 uav.lost, uav.lost_s = False, None
                 changes.append((uav_id, Change.BACK))
+            elif not uav.lost:
+                changes += _spell(uav_id, uav, silence)
         return changes
 
     def available(self, uav_id: str) -> bool:
@@ -187,23 +215,52 @@ class FleetMonitor:
             )
         return Traffic(uavs=entries)
 
-    def snapshot(self) -> list[UavState]:
-        """Every UAV's state for a :class:`proto.rpc.FleetReply`."""
-        return [
-            UavState(
-                uav_id=uav_id,
-                state=self.state(uav_id),
-                telemetry=uav.telemetry,
-                status=uav.status,
-                silent_s=self._silent_s(uav_id),
+    def snapshot(self, plans: Mapping[str, Plan]) -> list[UavState]:
+        """Every UAV's state for a :class:`proto.rpc.FleetReply`; a silent
+        one's tasks in ``plans`` (each UAV's current plan) are unknown."""
+        out = []
+        for uav_id, uav in self._uavs.items():
+            silent = uav.silent_since is not None and self._checked_s is not None
+            plan = plans.get(uav_id)
+            out.append(
+                UavState(
+                    uav_id=uav_id,
+                    state=self.state(uav_id),
+                    telemetry=uav.telemetry,
+                    status=uav.status,
+                    silent_s=round(self.silence_s(uav_id, self._checked_s), 1) if silent else None,
+                    silent_since_s=uav.silent_since if silent else None,
+                    unknown_tasks=unknown_tasks(plan, uav.status) if silent and plan else [],
+                )
             )
-            for uav_id, uav in self._uavs.items()
-        ]
+        return out
 
-    def _silent_s(self, uav_id: str) -> float | None:
-        """How long a present UAV has been silent, as of the last check, if
-        for ``SILENT_AFTER_S`` or more."""
-        if self._checked_s is None or self._uavs[uav_id].lost:
-            return None
-        silence = self.silence_s(uav_id, self._checked_s)
-        return round(silence, 1) if silence >= SILENT_AFTER_S else None
+
+def _spell(uav_id: str, uav: _Uav, silence: float) -> list[tuple[str, Change]]:
+    """A present UAV's silent spell begins (``SILENT``) or ends (``HEARD``), once each."""
+    silent = silence >= SILENT_AFTER_S
+    if silent and uav.silent_since is None:
+        uav.silent_since = _began(uav)
+        return [(uav_id, Change.SILENT)]
+    if not silent and uav.silent_since is not None:
+        uav.silent_since = None
+        return [(uav_id, Change.HEARD)]
+    return []
+
+
+def _began(uav: _Uav) -> float:
+    """Mission time the present UAV's silence began: when it was last heard,
+    or when its token vanished if that was earlier."""
+    assert uav.heard_s is not None and uav.heard_at is not None  # present: it was heard
+    token_first = uav.token_lost_s is not None and uav.token_lost_s < uav.heard_s
+    if not uav.token and token_first and uav.token_lost_at is not None:
+        return uav.token_lost_at
+    return uav.heard_at
+
+
+def unknown_tasks(plan: Plan, status: AgentStatus | None) -> list[str]:
+    """The tasks of ``plan`` a silent UAV may be flying or have yet to fly:
+    from the one it last reported running on (all if it reported none of them)."""
+    ids = [t.task_id for t in plan.tasks]
+    running = status.task_id if status is not None else None
+    return ids[ids.index(running) :] if running in ids else ids

@@ -22,6 +22,7 @@ from ground_station import inventory
 from ground_station.action_book import ActionBook
 from ground_station.agent_reports import AgentReports
 from ground_station.event_log import EventLog
+from ground_station.fleet_events import TOLD_ONLY, fleet_event
 from ground_station.fleet_monitor import Change, FleetMonitor
 from ground_station.fleet_state import AIRBORNE
 from ground_station.lifecycle import TERMINAL, TRANSITIONS, ActionEvent
@@ -58,23 +59,6 @@ from proto.rpc import (
 from proto.scenario import Scenario
 
 log = logging.getLogger(__name__)
-
-
-FLEET_EVENTS = {
-    Change.LOST: EventKind.UAV_LOST,
-    Change.BACK: EventKind.UAV_BACK,
-    Change.CRASHED: EventKind.UAV_CRASHED,
-    Change.FAILED: EventKind.UAV_LOST,
-    Change.NOT_READY: EventKind.UAV_STATE,
-}
-FLEET_TEXT = {
-    Change.LOST: "silent past the link timeout; its work goes to others",
-    Change.BACK: "heard again; it gets a fresh plan",
-    Change.CRASHED: "telemetry says crashed; its work goes to others at once",
-    Change.FAILED: "its agent reports failed; its work goes to others at once",
-    Change.NOT_READY: "not ready (its autopilot cannot arm yet); its work goes to others "
-    "until it is",
-}
 
 
 RETRY_UNPLACED_S = 30.0
@@ -160,7 +144,7 @@ class MissionManager:
         control = self.replanner.control
         uavs = [
             msgspec.structs.replace(u, control=control.command(u.uav_id))
-            for u in self.monitor.snapshot()
+            for u in self.monitor.snapshot(self.replanner.plans)
         ]
         return FleetReply(uavs=uavs)
 
@@ -270,13 +254,12 @@ class MissionManager:
 
     def on_fleet_changes(self, changes: list[tuple[str, Change]]) -> None:
         """A UAV was lost (after the grace), crashed, failed, is not ready, or
-        came back: replan."""
+        came back: replan. One fell silent or was heard again: only told."""
         for uav_id, change in changes:
-            detail = FLEET_TEXT[change]
-            status = self.monitor.status(uav_id)
-            if change == Change.NOT_READY and status is not None and status.reason:
-                detail = f"{status.reason}; its work goes to others until it is ready"
-            self.events.emit(FLEET_EVENTS[change], uav_id=uav_id, detail=detail)
+            kind, detail = fleet_event(self.monitor, uav_id, change)
+            self.events.emit(kind, uav_id=uav_id, detail=detail)
+        changes = [(u, c) for u, c in changes if c not in TOLD_ONLY]
+        for uav_id, change in changes:
             if change == Change.BACK:
                 self.replanner.resend(uav_id)
             else:

@@ -61,7 +61,9 @@ class GroundStation:
         self.future_stamps = 0  # samples dropped: stamped too far in the future
         self.generation = f"gs-{uuid.uuid4().hex[:12]}"  # this run, in every traffic report
         self.store = Store(config.db_path)
-        self.monitor = FleetMonitor([u.id for u in scenario.fleet.uavs], config.link_timeout_s)
+        self.monitor = FleetMonitor(
+            [u.id for u in scenario.fleet.uavs], config.link_timeout_s, mission_clock=clock
+        )
         self.events = EventLog(self.store, lambda e: bus.publish(self.keys.events(), e), clock)
         self.replanner = Replanner(
             scenario=scenario,

@@ -18,6 +18,8 @@ class EventKind(enum.StrEnum):
     REPLAN = "replan"
     ACTION_FAILED = "action_failed"
     HANDOVER = "handover"
+    UAV_SILENT = "uav_silent"  # present, unheard past SILENT_AFTER_S: its tasks are unknown
+    UAV_HEARD = "uav_heard"  # a silent UAV heard again within the link timeout
     UAV_LOST = "uav_lost"
     UAV_BACK = "uav_back"
     UAV_CRASHED = "uav_crashed"

@@ -158,9 +158,16 @@ class UavState(Record, frozen=True, kw_only=True):
     telemetry: Telemetry | None = None
     status: AgentStatus | None = None
     silent_s: Finite | None = None
-    """Seconds the UAV has been silent, while it is silent but within the
-    link timeout (not yet lost); None when heard normally or already lost.
-    Its tasks' fate is unknown meanwhile, not failed."""
+    """Seconds (on the watchdog's real-time clock) the UAV has been silent,
+    while it is silent but within the link timeout (not yet lost); None when
+    heard normally or already lost."""
+    silent_since_s: Finite | None = None
+    """When that silence began, in mission seconds of the ground station's
+    clock (the clock of telemetry stamps); set with ``silent_s``."""
+    unknown_tasks: list[Id] = []
+    """While silent: the ids of its planned tasks (the one it was running
+    and those after it) whose fate is unknown: neither failed nor known to
+    run. Heard again, they are what its reports say; lost, they go to others."""
     control: Command | None = None
     """The operator's command in force (None: the planner flies it)."""
 

@@ -8,6 +8,7 @@ from rich.table import Table
 from rich.text import Text
 
 from ground_station.planner.gantt import GLYPH
+from linecrew.clock import time_of_day
 
 
 def actions_table(records: list[dict[str, Any]]) -> Table:
@@ -29,6 +30,25 @@ def actions_table(records: list[dict[str, Any]]) -> Table:
     return table
 
 
+def silence_text(uav: dict[str, Any]) -> str:
+    """``silent since HH:MM:SS, N s`` (mission clock) for a silent UAV, else ""."""
+    silent, since = uav.get("silent_s"), uav.get("silent_since_s")
+    if not silent:
+        return ""
+    began = f" since {time_of_day(since)}," if since is not None else ""
+    return f"silent{began} {silent:.0f} s"
+
+
+def _task_text(uav: dict[str, Any], status: dict[str, Any]) -> str:
+    """The task the agent reports; a silent UAV's tasks are unknown."""
+    unknown = uav.get("unknown_tasks") or []
+    task = status.get("task_id") or "-"
+    if not unknown:
+        return task
+    more = f", +{len(unknown) - 1} pending" if len(unknown) > 1 else ""
+    return f"{unknown[0]} unknown{more}"
+
+
 def fleet_table(uavs: list[dict[str, Any]]) -> Table:
     """One row per UAV."""
     table = Table(title="Fleet")
@@ -37,8 +57,8 @@ def fleet_table(uavs: list[dict[str, Any]]) -> Table:
     for u in uavs:
         tel, status = u.get("telemetry") or {}, u.get("status") or {}
         pos = tel.get("position")
-        silent, control = u.get("silent_s"), u.get("control")
-        state = f"{u['state']} (silent {silent:.0f} s)" if silent else u["state"]
+        silence, control = silence_text(u), u.get("control")
+        state = f"{u['state']} ({silence})" if silence else u["state"]
         if status.get("holding_for"):
             state += f", holding off for {status['holding_for']}"
         table.add_row(
@@ -46,7 +66,7 @@ def fleet_table(uavs: list[dict[str, Any]]) -> Table:
             f"{state}, operator: {control}" if control else state,
             f"{100 * tel['battery_fraction']:.0f} %" if tel else "-",
             f"{pos['x_m']:.0f}, {pos['y_m']:.0f}, {pos['z_m']:.0f}" if pos else "-",
-            status.get("task_id") or "-",
+            _task_text(u, status),
             str(status.get("epoch", "-")),
         )
     return table

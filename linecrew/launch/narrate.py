@@ -142,6 +142,8 @@ def event_text(event: GsEvent) -> str | None:
             if m := HANDOVER.fullmatch(detail):
                 return f"hand-over: {m['new']} relieves {m['old']} watching {m['worker']}"
             return f"hand-over: {detail}"
+        case EventKind.UAV_SILENT | EventKind.UAV_HEARD:
+            return f"{uav} {detail}"
         case EventKind.UAV_LOST:
             return f"{uav} LOST: {detail}"
         case EventKind.UAV_BACK:

@@ -36,7 +36,8 @@ class Harness:
         self.sent: list[Plan] = []
         self.events: list[GsEvent] = []
         self.store = Store(db_path)
-        self.monitor = FleetMonitor([u.id for u in self.scenario.fleet.uavs], 5.0)
+        uav_ids = [u.id for u in self.scenario.fleet.uavs]
+        self.monitor = FleetMonitor(uav_ids, 5.0, mission_clock=lambda: self.now)
         log = EventLog(self.store, self.events.append, lambda: self.now)
         self.replanner = Replanner(
             scenario=self.scenario,

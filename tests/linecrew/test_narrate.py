@@ -183,3 +183,15 @@ def test_an_outcome_gives_the_reason_only_when_not_completed():
     failed = {"state": "failed", "progress": 0.4, "reason": "no UAV can reach waypoint 2"}
     assert outcome_text(done) == "completed (100 %)"
     assert outcome_text(failed) == "failed (40 %): no UAV can reach waypoint 2"
+
+
+def test_a_silent_spell_is_told_when_it_begins_and_when_it_ends():
+    narrator = Narrator(ORIGIN_S)
+    events = [
+        event(EventKind.UAV_SILENT, uav_id="uav-2", detail="silent since 10:00:05 (mission clock)"),
+        event(EventKind.UAV_HEARD, uav_id="uav-2", detail="heard again within the link timeout"),
+    ]
+    assert [line.split(" s  ", 1)[1] for line in narrator.lines(events, [])] == [
+        "uav-2 silent since 10:00:05 (mission clock)",
+        "uav-2 heard again within the link timeout",
+    ]

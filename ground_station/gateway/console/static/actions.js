@@ -4,7 +4,7 @@
 
 import { api } from "./api.js";
 import { el, Keyed, pct, text, toggle } from "./dom.js";
-import { onRender, state, upsertAction } from "./store.js";
+import { onRender, state, unknownTasks, upsertAction } from "./store.js";
 
 const TERMINAL = new Set(["completed", "failed", "cancelled"]);
 const COLUMNS = ["id", "type", "what", "state", "progress", "priority", "reason", "ops"];
@@ -55,16 +55,30 @@ function summary(a) {
   }
 }
 
+/** The actions with a task whose UAV is silent (their fate is unknown). */
+function unknownActions(s) {
+  const unknown = unknownTasks();
+  const out = new Set();
+  for (const plan of s.plans.values()) {
+    for (const t of plan.tasks) if (t.action_id && unknown.has(t.task_id)) out.add(t.action_id);
+  }
+  return out;
+}
+
 function render(s) {
   const records = [...s.actions.values()].sort((a, b) => b.created_s - a.created_s);
+  const unknown = unknownActions(s);
   for (const r of records) {
     const row = rows.get(r.action_id);
     const c = row.c;
     text(c.id, r.action_id);
     text(c.type, r.action.type);
     text(c.what, summary(r.action));
-    text(c.state, r.state);
+    const fate = unknown.has(r.action_id) && !TERMINAL.has(r.state);
+    text(c.state, fate ? `${r.state} · unknown` : r.state);
+    toggle(c.state, "unknown", fate);
     row.node.dataset.state = r.state;
+    row.node.dataset.fate = fate ? "unknown" : "";
     row.bar.value = r.progress;
     text(row.share, ` ${pct(r.progress)}`);
     if (document.activeElement !== row.priority && row.priority.dataset.shown !== String(r.action.priority)) {

@@ -1,4 +1,4 @@
-// Alerts: from ground-station events (UAV lost / crashed / back, action
+// Alerts: from ground-station events (UAV silent / heard again / lost / crashed / back, action
 // failed with its reason, faults such as a battery below plan) and from the
 // console itself (a fault it injected, a battery below the reserve seen in
 // telemetry). Each stays in the list until the operator acknowledges it;
@@ -17,6 +17,7 @@ const RANK = { critical: 0, error: 1, warning: 2, info: 3 };
 
 const alerts = new Map(); // key -> alert, in arrival order
 const lost = new Set(); // UAVs seen lost or crashed (so uav_back is "link back")
+const silent = new Set(); // UAVs seen silent and neither heard again nor lost since
 const acked = new Set(load(ACKED_KEY, []));
 const episodes = load(EPISODES_KEY, {});
 const nodes = new Map(); // key -> li
@@ -66,7 +67,14 @@ function fromEvent(e) {
   const uav = e.uav_id ? `${e.uav_id}: ` : "";
   const action = e.action_id ? `${e.action_id}: ` : "";
   switch (e.kind) {
+    case "uav_silent":
+      silent.add(e.uav_id);
+      return { severity: "warning", title: "UAV silent", detail: `${uav}${e.detail}` };
+    case "uav_heard":
+      if (!silent.delete(e.uav_id)) return null;
+      return { severity: "info", title: "UAV heard again", detail: `${uav}${e.detail}` };
     case "uav_lost":
+      silent.delete(e.uav_id);
       lost.add(e.uav_id);
       return { severity: "critical", title: "UAV lost", detail: `${uav}${e.detail}` };
     case "uav_crashed":

@@ -89,6 +89,13 @@ export function relative(seconds) {
   return `${sign}${m}:${String(r).padStart(2, "0")}`;
 }
 
+/** Mission seconds as the mission clock's time of day, "HH:MM:SS" (UTC). */
+export function timeOfDay(seconds) {
+  const s = Math.floor(seconds) % 86400;
+  const two = (n) => String(n).padStart(2, "0");
+  return `${two(Math.floor(s / 3600))}:${two(Math.floor(s / 60) % 60)}:${two(s % 60)}`;
+}
+
 export function pct(fraction) {
   return `${Math.round((fraction || 0) * 100)}%`;
 }

@@ -3,7 +3,7 @@
 // gives it back (resume); "hold all" above the table is a fleet stop.
 
 import { api } from "./api.js";
-import { attr, el, Keyed, pct, text, toggle } from "./dom.js";
+import { attr, el, Keyed, pct, text, timeOfDay, toggle } from "./dom.js";
 import { byId, currentTask, onRender, select, setFleet } from "./store.js";
 
 const COLUMNS = ["uav", "state", "flight", "battery", "alt", "heading", "task", "epoch", "control"];
@@ -44,9 +44,17 @@ async function command(path, button, name = button.dataset.command) {
   }
 }
 
+/** "silent since HH:MM:SS, N s" (mission clock) for a silent UAV, else "". */
+export function silenceText(uav) {
+  if (!uav.silent_s) return "";
+  const since = uav.silent_since_s != null ? ` since ${timeOfDay(uav.silent_since_s)},` : "";
+  return `silent${since} ${Math.round(uav.silent_s)} s`;
+}
+
 /** The UAV's state, with what keeps it waiting: silence, another UAV at its next point. */
 export function stateText(uav) {
-  let said = uav.silent_s ? `${uav.state} (silent ${Math.round(uav.silent_s)} s)` : uav.state;
+  const silence = silenceText(uav);
+  let said = silence ? `${uav.state} (${silence})` : uav.state;
   const other = uav.status && uav.status.holding_for;
   if (other) said += ` · holding off for ${other}`;
   return said;
@@ -70,7 +78,10 @@ function render(s) {
     text(c.alt, t ? t.position.z_m.toFixed(1) : "-");
     text(c.heading, t ? `${Math.round(t.heading_deg)}°` : "-");
     const progress = uav.status && uav.status.task_id ? ` ${pct(uav.status.progress)}` : "";
-    text(c.task, task ? `${task.task_id}${progress}` : "-");
+    const unknown = uav.unknown_tasks && uav.unknown_tasks.length ? uav.unknown_tasks : null;
+    text(c.task, unknown ? `${unknown[0]} unknown` : task ? `${task.task_id}${progress}` : "-");
+    toggle(c.task, "unknown", unknown);
+    row.node.dataset.silent = uav.silent_s ? "yes" : "";
     text(c.epoch, plan ? plan.epoch : uav.status ? uav.status.epoch : "-");
     for (const button of c.control.querySelectorAll("button")) {
       attr(button, "aria-pressed", String(button.dataset.command === uav.control));

@@ -2,8 +2,8 @@
 // (coloured by kind, labelled with its action), a "now" line on the
 // mission clock, each row's plan epoch. Rows and bars are kept by id.
 
-import { attr, el, Keyed, relative, text, toggle } from "./dom.js";
-import { byId, missionNow, onRender, select } from "./store.js";
+import { attr, el, Keyed, relative, text, timeOfDay, toggle } from "./dom.js";
+import { byId, missionNow, onRender, select, unknownTasks } from "./store.js";
 
 export const KINDS = {
   inspect: "inspect",
@@ -32,6 +32,7 @@ export function initGantt(node, legend) {
   for (const kind of Object.keys(KINDS)) {
     el("span", { class: `key kind-${kind}`, text: kind }, legend);
   }
+  el("span", { class: "key fate-unknown", text: "unknown (its UAV is silent)" }, legend);
   const rowLayer = el("svg:g", { class: "rows" }, svg);
   const tickLayer = el("svg:g", { class: "ticks" }, svg);
   const barLayer = el("svg:g", { class: "bars" }, svg);
@@ -112,6 +113,7 @@ function render(s) {
   attr(nowLabel, "y", TOP - 8);
 
   const keepBars = new Set();
+  const unknown = unknownTasks();
   let latest = null;
   ids.forEach((id, i) => {
     const y = TOP + i * ROW;
@@ -131,7 +133,10 @@ function render(s) {
       const bar = bars.get(key);
       const x = X(task.start_s);
       const w = Math.max(X(task.end_s) - x, 2);
-      attr(bar.node, "class", `bar kind-${task.type}${s.selected === id ? " selected" : ""}`);
+      const silent = unknown.get(task.task_id);
+      const fate = silent ? " unknown" : "";
+      attr(bar.node, "class", `bar kind-${task.type}${fate}${s.selected === id ? " selected" : ""}`);
+      attr(bar.node, "data-fate", silent ? "unknown" : "");
       attr(bar.node, "data-uav", id);
       attr(bar.node, "data-task", task.task_id);
       attr(bar.node, "data-kind", task.type);
@@ -148,7 +153,8 @@ function render(s) {
         `${task.type} ${task.task_id}` +
           (task.action_id ? `\naction ${task.action_id}` : "") +
           `\n${relative(task.start_s - now)} → ${relative(task.end_s - now)} (${Math.round(task.end_s - task.start_s)} s)` +
-          `\nenergy after ${task.energy_after_wh.toFixed(1)} Wh\nplan epoch ${plan.epoch}`,
+          `\nenergy after ${task.energy_after_wh.toFixed(1)} Wh\nplan epoch ${plan.epoch}` +
+          (silent ? `\nfate unknown: ${id} silent since ${timeOfDay(silent.silent_since_s)}` : ""),
       );
     });
   });

@@ -8,7 +8,7 @@
 import { api, askToken, followEvents, on, readFragment, token } from "./api.js";
 import { initActions } from "./actions.js";
 import { initAlerts, onEvent } from "./alerts.js";
-import { text } from "./dom.js";
+import { text, timeOfDay } from "./dom.js";
 import { initFleet } from "./fleet.js";
 import { initGantt } from "./gantt.js";
 import { initMap } from "./map.js";
@@ -157,7 +157,8 @@ async function start() {
 
 function tick() {
   const now = missionNow();
-  text($("clock"), now === null ? "mission clock: waiting for telemetry" : `mission clock ×${clockRate().toFixed(1)}`);
+  const shown = now === null ? "waiting for telemetry" : `${timeOfDay(now)} ×${clockRate().toFixed(1)}`;
+  text($("clock"), `mission clock ${shown}`);
   invalidate("gantt");
 }
 

@@ -109,6 +109,8 @@ export function setSite(site) {
   invalidate("map", "forms");
 }
 
+let shownUnknown = ""; // the unknown tasks the actions and the Gantt last showed
+
 export function setFleet(uavs) {
   const seen = new Set();
   let latest = null;
@@ -130,6 +132,11 @@ export function setFleet(uavs) {
   for (const id of [...state.fleet.keys()]) if (!seen.has(id)) state.fleet.delete(id);
   if (latest !== null) observeStamp(latest);
   invalidate("map", "fleet", "alerts-fleet", "sim");
+  const unknown = uavs.flatMap((u) => u.unknown_tasks || []).join(" ");
+  if (unknown !== shownUnknown) {
+    shownUnknown = unknown;
+    invalidate("actions", "gantt");
+  }
 }
 
 export function setWorkers(workers) {
@@ -179,6 +186,13 @@ export function taskTargets(task) {
     default:
       return [];
   }
+}
+
+/** Tasks whose fate is unknown while their UAV is silent: task id -> its UavState. */
+export function unknownTasks() {
+  const out = new Map();
+  for (const uav of state.fleet.values()) for (const id of uav.unknown_tasks || []) out.set(id, uav);
+  return out;
 }
 
 /** The task a UAV is flying: its agent's task id, else its plan's first. */
