@@ -1,15 +1,21 @@
-"""What the chaos runner does to the processes of a :class:`LocalRun`:
-``kill -9`` and restart with the same arguments, and partitions.
+"""What the chaos runner does to the processes of a run: ``kill -9`` and
+restart with the same arguments, and partitions.
 
-A partition on loopback is emulated by freezing the agent (SIGSTOP, healed
-by SIGCONT): a frozen process stops talking exactly like a cut link, so the
-ground station sees the same silence, loss, replan and return. What it does
-not reproduce is the agent's own side: a frozen agent cannot notice the
-silence, so it neither abandons its tasks nor lands while cut off (its
-vehicle hovers at its last set-point, draining its battery); the runner
-therefore excuses a later dip below reserve on that UAV. The network-
-namespace tests (``tests/chaos/test_netns_partitions.py``) cover the
-agent's side with real cut links.
+On a :class:`~linecrew.chaos.netns_run.NetnsRun` a partition is a real cut
+of the process's Zenoh link (nft in its namespace), healed by removing the
+rule; every side notices the silence and acts on its own rules (an agent
+abandons its tasks and lands at a station after its grace).
+
+On loopback (:class:`~linecrew.launch.local_run.LocalRun`) a partition is
+emulated by freezing the process (SIGSTOP, healed by SIGCONT): it stops
+talking exactly like a cut link, so the others see the same silence, loss,
+replan and return. What it does not reproduce is the frozen process's own
+side: a frozen agent cannot notice the silence, so it neither abandons its
+tasks nor lands (its vehicle hovers at its last set-point, draining its
+battery: the runner excuses a later dip below reserve on that UAV); a
+frozen ground station does not declare anyone lost meanwhile. A frozen
+gateway would also stall the observer's own REST calls, so the runner does
+not partition the gateway on loopback.
 """
 
 from __future__ import annotations
@@ -18,7 +24,9 @@ import contextlib
 import logging
 import os
 import signal
+from collections.abc import Mapping
 
+from linecrew.chaos.netns_run import NetnsRun
 from linecrew.launch.local_run import LocalRun
 from linecrew.launch.supervisor import Child
 
@@ -26,11 +34,12 @@ log = logging.getLogger(__name__)
 
 
 class ProcessFaults:
-    """Kill, restart, freeze and thaw the named children of ``run``."""
+    """Kill, restart, cut off and heal the named children of ``run``."""
 
-    def __init__(self, run: LocalRun) -> None:
+    def __init__(self, run: LocalRun | NetnsRun) -> None:
         self.run = run
-        self.frozen: set[str] = set()
+        self.real_cuts = isinstance(run, NetnsRun)
+        self.cut_off: set[str] = set()
         self._restarts: dict[str, int] = {}
 
     def child(self, name: str) -> Child:
@@ -45,29 +54,39 @@ class ProcessFaults:
         child.popen.wait()
         return child.popen.pid
 
-    def restart(self, name: str) -> Child:
-        """Start ``name`` again with its arguments; the old log is kept as ``name.N.log``."""
+    def restart(self, name: str, env: Mapping[str, str] | None = None) -> Child:
+        """Start ``name`` again with its arguments (in its namespace, if any) and
+        ``env`` added to the environment; the old log is kept as ``name.N.log``."""
         old = self.child(name)
         if old.alive():
             raise RuntimeError(f"{name} is still running")
         count = self._restarts[name] = self._restarts.get(name, 0) + 1
         if old.log_path.exists():
             old.log_path.rename(old.log_path.with_name(f"{name}.{count}.log"))
-        args = [str(a) for a in old.popen.args]  # [python, -m, module, *args]
-        return self.run.supervisor.start(name, args[2], *args[3:])
+        args = [str(a) for a in old.popen.args]  # [prefix..., python, -m, module, *args]
+        module = args.index("-m") + 1
+        return self.run.supervisor.start(name, args[module], *args[module + 1 :], env=env)
 
-    def freeze(self, name: str) -> None:
-        """SIGSTOP: the process goes silent as if its link were cut."""
-        os.kill(self.child(name).popen.pid, signal.SIGSTOP)
-        self.frozen.add(name)
+    def cut(self, name: str) -> None:
+        """Partition ``name``: its link cut (a namespace run) or the process frozen."""
+        if isinstance(self.run, NetnsRun):
+            self.run.cut(name)
+        else:
+            os.kill(self.child(name).popen.pid, signal.SIGSTOP)
+        self.cut_off.add(name)
 
-    def thaw(self, name: str) -> None:
-        """SIGCONT: the link is back."""
+    def heal(self, name: str) -> None:
+        """The link is back (the rule removed, or SIGCONT)."""
+        if name not in self.cut_off:
+            return
+        self.cut_off.discard(name)
+        if isinstance(self.run, NetnsRun):
+            self.run.heal(name)
+            return
         with contextlib.suppress(ProcessLookupError):
             os.kill(self.child(name).popen.pid, signal.SIGCONT)
-        self.frozen.discard(name)
 
-    def thaw_all(self) -> None:
-        """Thaw whatever is still frozen (before stopping the run)."""
-        for name in sorted(self.frozen):
-            self.thaw(name)
+    def heal_all(self) -> None:
+        """Heal whatever is still cut off (before stopping the run)."""
+        for name in sorted(self.cut_off):
+            self.heal(name)

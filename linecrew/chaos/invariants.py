@@ -4,8 +4,11 @@
   ground station whenever it answers.
 - ``double_task``: no piece of work is in two UAVs' current plans at once
   (an inspection waypoint, a pick-up or drop; a monitoring slot only if two
-  UAVs cover it for longer than a hand-over), and no two present UAVs report
-  executing the same such task on two consecutive samples.
+  UAVs cover it for longer than a hand-over), no two present UAVs report
+  executing the same such task on two consecutive samples, and (the
+  simulator's truth) no two UAVs hover at one spot watching the same worker
+  for longer than a hand-over: both credited watching it since the last
+  sample, flying, closer than ``SAME_SPOT_M`` horizontally.
 - ``below_reserve``: no vehicle (the simulator's truth) falls below the
   fleet's reserve fraction, unless a fault injected on it (battery fault,
   freeze, kill) made the reserve impossible: then it is reported as excused.
@@ -28,9 +31,10 @@ from __future__ import annotations
 import collections
 import dataclasses
 import itertools
+import math
 from typing import Any
 
-from proto import SimState
+from proto import Point, SimState
 
 TERMINAL = frozenset({"completed", "failed", "cancelled"})
 HANDOVER_S = 30.0  # mission seconds two monitoring segments of one slot may overlap
@@ -38,6 +42,7 @@ HANDOVER_S = 30.0  # mission seconds two monitoring segments of one slot may ove
 _OWN_TASKS = ("recharge", "wait", "home")
 CREDIT_TOLERANCE = 0.02  # recorded monitoring may exceed the watched seconds by this share
 CREDIT_SLACK_S = 5.0  # and by this many seconds per UAV of each monitor action
+SAME_SPOT_M = 2.0  # two watching UAVs this near hold one spot (slots, holds, asides: >= 3 m)
 
 
 @dataclasses.dataclass(frozen=True)
@@ -65,6 +70,8 @@ class Checker:
         self._seen: set[tuple[str, str]] = set()  # (invariant, detail) already reported
         self._unsafe_seen = 0  # the simulator's violations already judged
         self._overcredited: set[str] = set()  # workers already reported
+        self._watched: dict[tuple[str, str], float] = {}  # (worker, uav) -> watched s, last sample
+        self._together: dict[tuple[str, str, str], float] = {}  # (worker, uav, uav) -> since sim s
 
     # -- inputs ------------------------------------------------------------------
 
@@ -94,6 +101,7 @@ class Checker:
         if truth is not None:
             self._check_reserve(at_s, truth)
             self._check_safety(at_s, truth)
+            self._check_one_spot(at_s, truth)
             if actions is not None:  # the truth was read after the actions
                 self._check_credit(at_s, actions, truth)
 
@@ -204,6 +212,34 @@ class Checker:
                 self._violate(at_s, "unsafe", where)
         self._unsafe_seen = max(self._unsafe_seen, len(truth.violations))
 
+    def _check_one_spot(self, at_s: float, truth: SimState) -> None:
+        """Two UAVs watching one worker from one spot (the simulator's truth)."""
+        self.checks["double_task"] += 1
+        seconds = {(w.worker_id, w.uav_id): w.seconds for w in truth.watched}
+        flying = {v.uav_id: v.position for v in truth.vehicles if v.state == "flying"}
+        watching: dict[str, list[str]] = collections.defaultdict(list)
+        for (worker, uav), s in sorted(seconds.items()):
+            if uav in flying and s > self._watched.get((worker, uav), 0.0):
+                watching[worker].append(uav)
+        self._watched = seconds
+        together = {
+            (worker, a, b)
+            for worker, uavs in watching.items()
+            for a, b in itertools.combinations(uavs, 2)
+            if _horizontal(flying[a], flying[b]) <= SAME_SPOT_M
+        }
+        self._together = {
+            pair: self._together.get(pair, truth.sim_time_s) for pair in sorted(together)
+        }
+        for (worker, a, b), since in self._together.items():
+            if truth.sim_time_s - since > HANDOVER_S:
+                self._violate(
+                    at_s,
+                    "double_task",
+                    f"{worker} watched by {a} and {b} from one spot for over {HANDOVER_S:.0f} s "
+                    f"from sim {since:.0f} s (simulator's truth)",
+                )
+
     def _check_credit(self, at_s: float, actions: list[dict[str, Any]], truth: SimState) -> None:
         self.checks["overcredited"] += 1
         recorded: collections.Counter[str] = collections.Counter()
@@ -234,6 +270,10 @@ class Checker:
             return
         self._seen.add((invariant, detail))
         self.violations.append(Violation(at_s, invariant, detail))
+
+
+def _horizontal(p: Point, q: Point) -> float:
+    return math.hypot(p.x_m - q.x_m, p.y_m - q.y_m)
 
 
 def _work_keys(task: dict[str, Any]) -> list[str]:

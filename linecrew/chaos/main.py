@@ -1,8 +1,12 @@
-"""``linecrew chaos --seed S --duration T``: start a local fleet, inject a
-seeded random mix (partitions of random length, process kills, battery
-faults, new actions), check the invariants continuously, print a report.
-Exit 0 if no invariant broke, 1 on a violation, 2 if the fleet did not start.
-The same seed gives the same schedule (``--schedule-only`` prints it)."""
+"""``linecrew chaos --seed S --duration T [--netns]``: start a local fleet,
+inject a seeded random mix (partitions of random length and bursts of short
+cuts, process kills, a router kill during a replan, faults, new actions),
+check the invariants continuously, print a report. Partitions freeze the
+process on loopback; with ``--netns`` every process runs in a network
+namespace of its own and a partition cuts its Zenoh link for real (needs
+root: ``ip netns add``). Exit 0 if no invariant broke, 1 on a violation, 2
+if the fleet did not start. The same seed gives the same schedule
+(``--schedule-only`` prints it)."""
 
 from __future__ import annotations
 
@@ -10,6 +14,7 @@ import argparse
 import pathlib
 import sys
 
+from linecrew.chaos.netns import NetnsError, check_available
 from linecrew.chaos.report import render
 from linecrew.chaos.runner import ChaosOptions, ChaosRunner
 from linecrew.chaos.schedule import make_schedule
@@ -35,6 +40,9 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument(
         "--no-scenario-actions", action="store_true", help="only the chaos schedule's actions"
     )
+    parser.add_argument(
+        "--netns", action="store_true", help="real cuts: each process in its own network namespace"
+    )
     parser.add_argument("--schedule-only", action="store_true", help="print the schedule, exit")
     parser.add_argument("--log-level", default="warning")
     args = parser.parse_args(argv)
@@ -45,7 +53,7 @@ def main(argv: list[str] | None = None) -> int:
         print(f"linecrew chaos: {exc}", file=sys.stderr)
         return 2
     if args.schedule_only:
-        for injection in make_schedule(args.seed, args.duration, scenario):
+        for injection in make_schedule(args.seed, args.duration, scenario, args.netns):
             print(f"{injection.at_s:6.1f}  {injection.describe()}")
         return 0
     options = ChaosOptions(
@@ -55,9 +63,15 @@ def main(argv: list[str] | None = None) -> int:
         speedup=args.speedup,
         run_dir=args.run_dir,
         scenario_actions=not args.no_scenario_actions,
+        netns=args.netns,
     )
     try:
+        if args.netns:
+            check_available()  # refused before anything starts
         result = ChaosRunner(scenario, options, Shutdown().install()).run()
+    except NetnsError as exc:
+        print(f"linecrew chaos: --netns: {exc}", file=sys.stderr)
+        return 2
     except StartError as exc:
         print(f"linecrew chaos: {exc}", file=sys.stderr)
         return 2

@@ -3,7 +3,7 @@ final state of every action, and how to reproduce the run."""
 
 from __future__ import annotations
 
-from linecrew.chaos.runner import ChaosResult
+from linecrew.chaos.runner import ChaosOptions, ChaosResult
 
 INVARIANTS = (
     "action_lost",
@@ -22,6 +22,8 @@ def render(result: ChaosResult) -> str:
     lines = [
         f"linecrew chaos: seed {opts.seed}, {opts.duration_s:g} s of injections, "
         f"x{opts.speedup:g}, {result.wall_s:.0f} s wall, {result.samples} samples",
+        "partitions: "
+        + ("real cuts (a network namespace per process)" if opts.netns else "frozen (SIGSTOP)"),
         f"run directory: {result.run_dir}",
         "",
         "injections (wall s since start):",
@@ -60,7 +62,17 @@ def render(result: ChaosResult) -> str:
     lines += [
         "",
         f"violations: {len(checker.violations)}",
-        f"reproduce: linecrew chaos --seed {opts.seed} --duration {opts.duration_s:g} "
-        f"--speedup {opts.speedup:g}",
+        f"reproduce: {reproduce(opts)}",
     ]
     return "\n".join(lines)
+
+
+def reproduce(opts: ChaosOptions) -> str:
+    """The command line that runs the same schedule on the same kind of fleet."""
+    words = ["linecrew chaos", f"--seed {opts.seed}", f"--duration {opts.duration_s:g}"]
+    words += [f"--speedup {opts.speedup:g}", f"--drain {opts.drain_s:g}"]
+    if not opts.scenario_actions:
+        words.append("--no-scenario-actions")
+    if opts.netns:
+        words.append("--netns")
+    return " ".join(words)

@@ -1,11 +1,14 @@
-"""The chaos run: a :class:`LocalRun` of the scenario, its scripted actions,
+"""The chaos run: a :class:`LocalRun` of the scenario (with ``netns``, a
+:class:`~linecrew.chaos.netns_run.NetnsRun`: real cuts), its scripted actions,
 then the seeded schedule of injections, with the invariants checked on every
 sample (gateway + simulator truth, twice a wall second) and a drain phase in
 which every accepted action must end.
 
 Submissions whose outcome is unknown (the ground station was down: 503,
 timeout) are retried with the same ``request_id`` until they get an answer,
-so "accepted" always means a 2xx the operator saw.
+so "accepted" always means a 2xx the operator saw. Cuts and their heals run
+on a :class:`Timeline` thread, on time whatever the REST calls of the loop
+wait for; kills and restarts stay on the loop (the main thread).
 """
 
 from __future__ import annotations
@@ -21,9 +24,13 @@ from typing import Any
 import httpx
 import msgspec
 
+from linecrew.chaos.cuts import process_name
 from linecrew.chaos.faults import ProcessFaults
+from linecrew.chaos.injections import APPLIERS, Context
 from linecrew.chaos.invariants import TERMINAL, Checker
-from linecrew.chaos.schedule import Injection, make_schedule
+from linecrew.chaos.netns_run import NetnsRun
+from linecrew.chaos.schedule import CUTS, Injection, make_schedule
+from linecrew.chaos.timeline import Timeline
 from linecrew.launch.local_run import LocalRun, RunOptions
 from linecrew.process import Shutdown
 from proto import GetHistory, GetSimState, HistoryReply, SimState
@@ -34,6 +41,7 @@ log = logging.getLogger(__name__)
 
 SAMPLE_EVERY_S = 0.5
 RETRY_EVERY_S = 1.0
+FINAL_WAIT_S = 10.0  # how long the final action list may take to answer
 
 
 @dataclasses.dataclass(frozen=True, kw_only=True)
@@ -46,6 +54,7 @@ class ChaosOptions:
     speedup: float = 10.0
     run_dir: pathlib.Path | None = None
     scenario_actions: bool = True  # also submit the scenario's scripted actions
+    netns: bool = False  # every process in a network namespace: partitions are real cuts
 
 
 @dataclasses.dataclass
@@ -85,26 +94,30 @@ class ChaosRunner:
         self.scenario = scenario
         self.options = options
         self.shutdown = shutdown
-        self.schedule = make_schedule(options.seed, options.duration_s, scenario)
+        self.schedule = make_schedule(options.seed, options.duration_s, scenario, options.netns)
         self.checker = Checker(scenario.fleet.reserve_fraction)
         self.applied: list[Applied] = []
         self.rejected: dict[str, str] = {}
         self._unsure: dict[str, dict[str, Any]] = {}  # action id -> body, outcome unknown
         self._heals: list[tuple[float, int, Callable[[], None]]] = []
+        self._context: Context | None = None  # what the appliers of injections.py act on
         self._t0 = 0.0
+        self.timeline = Timeline(self._now)
 
     def run(self) -> ChaosResult:
         """Start the fleet, inject, check, drain; the result (never raises on a violation)."""
         opts = self.options
         run_options = RunOptions(speedup=opts.speedup, run_dir=opts.run_dir)
-        with LocalRun(self.scenario, run_options) as run:
+        fleet = NetnsRun if opts.netns else LocalRun
+        with fleet(self.scenario, run_options) as run:
             faults = ProcessFaults(run)
             http = run.http(timeout_s=4.0)
             try:
                 samples, actions = self._loop(run, faults, http)
                 events = self._event_counts(run)
             finally:
-                faults.thaw_all()
+                self.timeline.close()
+                faults.heal_all()
                 http.close()
         return ChaosResult(
             options=opts,
@@ -155,14 +168,22 @@ class ChaosRunner:
             if now >= opts.duration_s + opts.drain_s:
                 break
             self.shutdown.wait(0.05)
-        while self._heals:  # a shutdown or the drain deadline: heal what is still broken
+        self.timeline.close()  # a shutdown or the drain deadline: heal what is still broken
+        while self._heals:
             heapq.heappop(self._heals)[2]()
-        final = self._get(http, "/v1/actions")
+        final = self._final(http)
         self.checker.finish(self._now(), final)
         return samples, final if final is not None else actions
 
+    def _final(self, http: httpx.Client) -> list[dict[str, Any]] | None:
+        """The last action list; the gateway may need a moment after a heal."""
+        deadline = self._now() + FINAL_WAIT_S
+        while (final := self._get(http, "/v1/actions")) is None and self._now() < deadline:
+            time.sleep(0.25)
+        return final
+
     def _settled(self, actions: list[dict[str, Any]] | None, scripted: list[Any]) -> bool:
-        if actions is None or scripted or self._unsure or self._heals:
+        if actions is None or scripted or self._unsure or self._heals or self.timeline.pending():
             return False
         states = {r["action_id"]: r["state"] for r in actions}
         return all(states.get(a) in TERMINAL for a in self.checker.accepted_at)
@@ -179,11 +200,10 @@ class ChaosRunner:
         self.applied.append(applied)
         log.info("inject %s", injection.describe())
         kind, target = injection.kind, injection.target
-        if kind == "partition":
-            name = f"agent-{target}"
-            faults.freeze(name)
-            self.checker.excuse(target, f"frozen {injection.hold_s:.1f} s")
-            self._later(injection, applied, lambda: faults.thaw(name))
+        if kind in CUTS:
+            self._cut(injection, applied, faults)
+        elif kind == "replan_kill_router":
+            self._replan_kill(injection, applied, faults, http)
         elif kind in {"kill_agent", "kill_gs", "kill_router"}:
             name = {"kill_gs": "ground-station", "kill_router": "router"}.get(
                 kind, f"agent-{target}"
@@ -200,6 +220,20 @@ class ChaosRunner:
                 applied.note = f"HTTP {response.status_code}"
             except httpx.HTTPError as exc:
                 applied.note = f"not applied: {exc}"
+        elif kind in APPLIERS:
+            if self._context is None:
+                self._context = Context(
+                    run=run,
+                    faults=faults,
+                    http=http,
+                    checker=self.checker,
+                    speedup=self.options.speedup,
+                    now=self._now,
+                    submit=lambda body: self._submit(http, body),
+                )
+            heal = APPLIERS[kind](injection, self._context, applied)
+            if heal is not None:
+                self._later(injection, applied, heal)
         else:
             applied.note = self._submit(http, dict(injection.params))
 
@@ -210,6 +244,41 @@ class ChaosRunner:
 
         due = applied.at_s + injection.hold_s
         heapq.heappush(self._heals, (due, len(self.applied), healed))
+
+    def _cut(self, injection: Injection, applied: Applied, faults: ProcessFaults) -> None:
+        """Partition the target once, or in a burst of short cuts, on the timeline.
+        A frozen agent cannot land on its own: a later dip below reserve is excused."""
+        name = process_name(injection.target)
+        if not faults.real_cuts and name.startswith("agent-"):
+            self.checker.excuse(injection.target, f"frozen within {injection.hold_s:.1f} s")
+
+        def heal() -> None:
+            faults.heal(name)
+            applied.healed_s = self._now()
+
+        for offset, hold in injection.params.get("cuts") or [[0.0, injection.hold_s]]:
+            self.timeline.at(applied.at_s + offset, lambda: faults.cut(name))
+            self.timeline.at(applied.at_s + offset + hold, heal)
+
+    def _replan_kill(
+        self, injection: Injection, applied: Applied, faults: ProcessFaults, http: httpx.Client
+    ) -> None:
+        """Submit the action, ``kill -9`` the router ``kill_after_s`` after the
+        answer (while the ground station replans), restart it ``down_s`` later.
+        Both on the loop: a child must be started on the main thread (its
+        PR_SET_PDEATHSIG follows the thread that started it)."""
+        params = injection.params
+        applied.note = self._submit(http, dict(params["action"]))
+        kill_at = self._now() + params["kill_after_s"]
+
+        def restart() -> None:
+            child = faults.restart("router")
+            applied.note += f"; router restarted as pid {child.popen.pid}"
+            applied.healed_s = self._now()
+
+        order = len(self.applied)
+        heapq.heappush(self._heals, (kill_at, order, lambda: faults.kill("router")))
+        heapq.heappush(self._heals, (kill_at + params["down_s"], order, restart))
 
     def _restart(self, faults: ProcessFaults, name: str, applied: Applied) -> None:
         child = faults.restart(name)

@@ -3,9 +3,15 @@
 on which target, when, for how long, with which parameters).
 
 Times are wall seconds since the chaos phase started. Disruptions
-(partitions and kills) never overlap each other, so every disruption's
-effect can be told apart in the report; battery faults and new actions fall
-anywhere, including inside a disruption.
+(partitions of an agent or a ground process, bursts of short cuts, kills, a
+router kill right after a new action's answer (during its replan), the
+store's disk made read-only, an agent restarted on a wrong clock) never
+overlap each other, so every disruption's effect can be
+told apart in the report (and a ground station is never restarted onto a
+disk it cannot write); battery, motor and GPS faults, new actions, cancels
+and edits fall anywhere, including inside a disruption. Cancels and edits
+name one of the two latest chaos actions; at most one motor fault brings a UAV down, so
+the others can take over its work.
 """
 
 from __future__ import annotations
@@ -14,18 +20,32 @@ import dataclasses
 import random
 from typing import Any
 
+from linecrew.chaos.cuts import burst, cut_target
 from proto.scenario import Scenario
 
-DISRUPTIONS = frozenset({"partition", "kill_agent", "kill_gs", "kill_router"})
+DISRUPTIONS = frozenset(
+    {"partition", "cut_burst", "kill_agent", "kill_gs", "kill_router", "replan_kill_router"}
+    | {"disk", "clock_jump"}
+)
+UAV_TARGETED = frozenset({"kill_agent", "clock_jump"})
+CUTS = frozenset({"partition", "cut_burst"})  # target: a UAV id or a ground process
 
 # kind -> relative weight of being picked at each step
 WEIGHTS: dict[str, float] = {
     "partition": 3.0,
+    "cut_burst": 1.0,
     "kill_agent": 1.0,
     "kill_gs": 1.0,
-    "kill_router": 1.0,
+    "kill_router": 0.5,
+    "replan_kill_router": 0.5,
     "battery": 1.5,
     "action": 2.5,
+    "cancel": 0.8,
+    "edit": 1.0,
+    "motor": 0.4,
+    "gps": 1.0,
+    "disk": 1.0,
+    "clock_jump": 0.8,
 }
 
 
@@ -35,62 +55,140 @@ class Injection:
 
     at_s: float  # wall seconds since the chaos phase started
     kind: str  # a key of WEIGHTS
-    target: str = ""  # a UAV id for partition, kill_agent, battery; "" otherwise
-    hold_s: float = 0.0  # partitions and kills: wall seconds until healed / restarted
+    target: str = ""  # a UAV id (kill_agent, battery, motor, gps, clock_jump), a UAV
+    # id or ground process (partition, cut_burst), an action id (cancel, edit); else ""
+    hold_s: float = 0.0  # wall seconds until healed / restarted / re-checked
     params: dict[str, Any] = dataclasses.field(default_factory=dict)
 
     def describe(self) -> str:
         """One line for the report."""
         what = {
             "partition": f"partition {self.target} for {self.hold_s:.1f} s",
+            "cut_burst": f"cut {self.target} {len(self.params.get('cuts', []))} times "
+            f"({', '.join(f'{h:.1f}' for _, h in self.params.get('cuts', []))} s) "
+            f"within {self.hold_s:.1f} s",
             "kill_agent": f"kill -9 agent {self.target}, restart after {self.hold_s:.1f} s",
             "kill_gs": f"kill -9 ground station, restart after {self.hold_s:.1f} s",
             "kill_router": f"kill -9 router, restart after {self.hold_s:.1f} s",
+            "replan_kill_router": f"new action {self.params.get('action', {}).get('action_id')}"
+            f", kill -9 router {self.params.get('kill_after_s', 0):.2f} s after its answer, "
+            f"restart {self.params.get('down_s', 0):.1f} s later",
             "battery": f"battery of {self.target} to {self.params.get('fraction', 0):.2f}",
             "action": f"new action {self.params.get('action_id', '')} "
             f"({self.params.get('type', '')})",
+            "cancel": f"cancel {self.target}",
+            "edit": f"edit {self.target}: {_change(self.params.get('change', {}))}",
+            "motor": f"motors of {self.target} fail",
+            "gps": f"GPS of {self.target} frozen for {self.hold_s:.1f} s",
+            "disk": f"store's disk read-only for {self.hold_s:.1f} s, probe action "
+            f"{self.params.get('action_id', '')}",
+            "clock_jump": f"restart agent {self.target} with its clock "
+            f"{self.params.get('offset_s', 0):+.0f} mission s off, back after {self.hold_s:.1f} s",
         }
         return what.get(self.kind, self.kind)
 
 
-def make_schedule(seed: int, duration_s: float, scenario: Scenario) -> list[Injection]:
+def make_schedule(
+    seed: int,
+    duration_s: float,
+    scenario: Scenario,
+    netns: bool = False,
+    mix: dict[str, float] | None = None,
+) -> list[Injection]:
     """The injections of a run of ``duration_s`` wall seconds on ``scenario``'s
-    fleet. Pure: the same arguments give the same list."""
+    fleet; ``netns``: partitions are real cuts (the gateway may be cut too);
+    ``mix``: other weights than :data:`WEIGHTS` (a focused run).
+    Pure: the same arguments give the same list."""
     rng = random.Random(seed)
     uavs = [u.id for u in scenario.fleet.uavs]
-    kinds = sorted(WEIGHTS)
-    weights = [WEIGHTS[k] for k in kinds]
+    mix = WEIGHTS if mix is None else mix
+    kinds = sorted(k for k in mix if mix[k] > 0)
+    weights = [mix[k] for k in kinds]
     schedule: list[Injection] = []
     t = rng.uniform(3.0, 6.0)
     disruption_free_s = 0.0  # when the last disruption has healed
     serial = 0
     used_tools = {a.action.tool for a in scenario.actions if hasattr(a.action, "tool")}
+    submitted: dict[str, dict[str, Any]] = {}  # chaos action id -> its body
+    fallen = False  # a motor fault was scheduled
     while t < duration_s:
         kind = rng.choices(kinds, weights)[0]
         if kind in DISRUPTIONS:
             t = max(t, disruption_free_s + rng.uniform(2.0, 5.0))
             if t >= duration_s:
                 break
+        at_s = round(t, 2)
+        if kind in DISRUPTIONS:
             hold = _hold_s(rng, kind)
-            target = rng.choice(uavs) if kind in {"partition", "kill_agent"} else ""
-            schedule.append(Injection(at_s=round(t, 2), kind=kind, target=target, hold_s=hold))
+            target = rng.choice(uavs) if kind in UAV_TARGETED else ""
+            params: dict[str, Any] = {}
+            if kind in CUTS:
+                target = cut_target(rng, uavs, netns)
+            if kind == "cut_burst":
+                params = {"cuts": burst(rng)}
+                hold = round(sum(params["cuts"][-1]), 2)
+            elif kind == "replan_kill_router":
+                serial += 1
+                action = _random_action(rng, scenario, f"chaos-{seed}-{serial}", used_tools)
+                kill_after = round(rng.uniform(0.05, 0.5), 2)
+                params = {"action": action, "kill_after_s": kill_after, "down_s": hold}
+                hold = round(kill_after + hold, 2)
+            elif kind == "clock_jump":
+                params = {"offset_s": rng.choice([-1, 1]) * round(rng.uniform(2.0, 30.0))}
+            elif kind == "disk":
+                serial += 1
+                params = _random_action(rng, scenario, f"chaos-{seed}-{serial}", used_tools)
+            schedule.append(
+                Injection(at_s=at_s, kind=kind, target=target, hold_s=hold, params=params)
+            )
             disruption_free_s = t + hold
         elif kind == "battery":
             fraction = round(rng.uniform(0.3, 0.7), 2)
             schedule.append(
                 Injection(
-                    at_s=round(t, 2),
-                    kind=kind,
-                    target=rng.choice(uavs),
-                    params={"fraction": fraction},
+                    at_s=at_s, kind=kind, target=rng.choice(uavs), params={"fraction": fraction}
                 )
+            )
+        elif kind == "gps":
+            hold = round(rng.uniform(0.5, 3.0), 2)
+            schedule.append(Injection(at_s=at_s, kind=kind, target=rng.choice(uavs), hold_s=hold))
+        elif kind == "motor":
+            if fallen or len(uavs) < 2:
+                continue  # the draw is spent; the next one picks again at the same time
+            fallen = True
+            schedule.append(Injection(at_s=at_s, kind=kind, target=rng.choice(uavs)))
+        elif kind in {"cancel", "edit"}:
+            if not submitted:
+                continue
+            action_id = rng.choice(list(submitted)[-2:])  # a recent one: likely still live
+            params = {"change": _edit(rng, submitted[action_id])} if kind == "edit" else {}
+            hold = round(rng.uniform(2.0, 6.0), 2)
+            schedule.append(
+                Injection(at_s=at_s, kind=kind, target=action_id, hold_s=hold, params=params)
             )
         else:
             serial += 1
             params = _random_action(rng, scenario, f"chaos-{seed}-{serial}", used_tools)
-            schedule.append(Injection(at_s=round(t, 2), kind=kind, params=params))
+            submitted[params["action_id"]] = params
+            schedule.append(Injection(at_s=at_s, kind=kind, params=params))
         t += rng.uniform(1.5, 6.0)
     return schedule
+
+
+def _edit(rng: random.Random, body: dict[str, Any]) -> dict[str, Any]:
+    """A PATCH body for the action submitted as ``body``: a monitoring's new
+    duration (the whole action), else a new priority."""
+    if body["type"] == "monitor" and rng.random() < 0.6:
+        action = {k: v for k, v in body.items() if k not in {"action_id", "request_id"}}
+        return {"action": action | {"duration_s": round(rng.uniform(20, 90))}}
+    return {"priority": rng.randint(1, 5)}
+
+
+def _change(change: dict[str, Any]) -> str:
+    """The report's words for an edit."""
+    if "action" in change:
+        return f"duration {change['action'].get('duration_s', 0):g} s"
+    return f"priority {change.get('priority', '')}"
 
 
 def _hold_s(rng: random.Random, kind: str) -> float:
@@ -103,6 +201,10 @@ def _hold_s(rng: random.Random, kind: str) -> float:
         return round(rng.uniform(1.0, 6.0), 2)
     if kind == "kill_gs":
         return round(rng.uniform(0.5, 4.0), 2)
+    if kind == "disk":
+        return round(rng.uniform(2.0, 6.0), 2)
+    if kind == "clock_jump":
+        return round(rng.uniform(3.0, 8.0), 2)
     return round(rng.uniform(0.5, 3.0), 2)
 
 

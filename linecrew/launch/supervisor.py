@@ -15,7 +15,7 @@ import signal
 import subprocess
 import sys
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 
 log = logging.getLogger(__name__)
 
@@ -56,13 +56,16 @@ class Supervisor:
         self.run_dir = run_dir
         self.children: list[Child] = []
 
-    def start(self, name: str, module: str, *args: str) -> Child:
-        """Start ``python -m module args...`` logging to ``run_dir/name.log``."""
+    def start(
+        self, name: str, module: str, *args: str, env: Mapping[str, str] | None = None
+    ) -> Child:
+        """Start ``python -m module args...`` logging to ``run_dir/name.log``,
+        with ``env`` added to this process's environment."""
         log_path = self.run_dir / f"{name}.log"
-        env = dict(os.environ, PYTHONUNBUFFERED="1")
+        env = dict(os.environ, **(env or {}), PYTHONUNBUFFERED="1")
         with open(log_path, "wb") as log_file:
             popen = subprocess.Popen(
-                [sys.executable, "-m", module, *args],
+                [*self.command_prefix(name), sys.executable, "-m", module, *args],
                 stdout=log_file,
                 stderr=subprocess.STDOUT,
                 stdin=subprocess.DEVNULL,
@@ -73,6 +76,10 @@ class Supervisor:
         child = Child(name, popen, log_path)
         self.children.append(child)
         return child
+
+    def command_prefix(self, name: str) -> list[str]:
+        """What runs child ``name``'s command (none: it runs here)."""
+        return []
 
     def wait_ready(self, child: Child, ready: Callable[[], object], timeout_s: float) -> None:
         """Wait until ``ready()``; raise :class:`StartError` if the child dies or is late."""

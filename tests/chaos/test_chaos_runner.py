@@ -3,14 +3,26 @@ real local fleet ends with a report of zero violations."""
 
 from __future__ import annotations
 
+import heapq
+import importlib
 import itertools
+import threading
+import time
+import types
 
+import httpx
 import pytest
 
-from linecrew.chaos import Checker, main, make_schedule
+from linecrew.chaos import ChaosOptions, ChaosRunner, Checker, main, make_schedule
+from linecrew.chaos.netns import NetnsError
+from linecrew.chaos.report import reproduce
 from linecrew.chaos.schedule import DISRUPTIONS
+from linecrew.chaos.timeline import Timeline
+from linecrew.process import Shutdown
 from linecrew.scenarios import load
 from proto import Point, SafetyViolation, SimState, WatchRecord
+
+chaos_main = importlib.import_module("linecrew.chaos.main")  # the package exports main()
 
 PAPER = load("paper")
 SEED = 7
@@ -23,9 +35,10 @@ def test_a_seed_gives_the_same_schedule_every_time():
     assert {i.kind for i in first} >= {"partition", "action"}
 
 
+@pytest.mark.parametrize("netns", [False, True])
 @pytest.mark.parametrize("seed", range(20))
-def test_disruptions_never_overlap_and_stay_in_the_run(seed):
-    schedule = make_schedule(seed, 90.0, PAPER)
+def test_disruptions_never_overlap_and_stay_in_the_run(seed, netns):
+    schedule = make_schedule(seed, 90.0, PAPER, netns)
     disruptions = [i for i in schedule if i.kind in DISRUPTIONS]
     for before, after in itertools.pairwise(disruptions):
         assert before.at_s + before.hold_s < after.at_s
@@ -121,3 +134,152 @@ def test_the_checker_flags_monitoring_recorded_beyond_what_the_simulator_saw_wat
     assert [(v.invariant, v.detail) for v in checker.violations] == [
         ("overcredited", "W2: 120 UAV-s of monitoring recorded, 50 s watched")
     ]
+
+
+def _cuts(netns: bool) -> list:
+    return [
+        i
+        for seed in range(40)
+        for i in make_schedule(seed, 120.0, PAPER, netns)
+        if i.kind in {"partition", "cut_burst"}
+    ]
+
+
+def test_partitions_cut_agents_and_ground_processes_the_gateway_only_for_real():
+    uavs = {u.id for u in PAPER.fleet.uavs}
+    real = {i.target for i in _cuts(True)}
+    frozen = {i.target for i in _cuts(False)}
+    assert real == uavs | {"ground-station", "gateway", "router"}
+    assert frozen == uavs | {"ground-station", "router"}  # a frozen gateway stalls the observer
+    holds = [i.hold_s for i in _cuts(True) if i.kind == "partition"]
+    assert any(3.0 < h < 5.0 for h in holds), "cuts at the agents' and the gs's grace boundary"
+
+
+def test_a_burst_is_three_to_five_short_cuts_with_gaps_inside_its_hold():
+    bursts = [i for i in _cuts(True) if i.kind == "cut_burst"]
+    assert bursts
+    for burst in bursts:
+        cuts = burst.params["cuts"]
+        assert 3 <= len(cuts) <= 5
+        assert all(0.5 <= hold <= 1.5 for _, hold in cuts)
+        for (start, hold), (after, _) in itertools.pairwise(cuts):
+            assert 0.29 <= after - (start + hold) <= 1.51  # rounded to 0.01 s
+        assert burst.hold_s == pytest.approx(sum(cuts[-1]), abs=0.01)
+
+
+def test_a_router_kill_follows_a_new_action_within_half_a_second():
+    kills = [
+        i
+        for seed in range(40)
+        for i in make_schedule(seed, 120.0, PAPER)
+        if i.kind == "replan_kill_router"
+    ]
+    assert kills
+    for kill in kills:
+        assert kill.params["action"]["action_id"].startswith("chaos-")
+        assert 0 < kill.params["kill_after_s"] <= 0.5
+        assert kill.hold_s == pytest.approx(kill.params["kill_after_s"] + kill.params["down_s"])
+
+
+def test_the_timeline_runs_steps_in_due_order_on_time_and_the_rest_at_close():
+    t0 = time.monotonic()
+    timeline = Timeline(lambda: time.monotonic() - t0)
+    done: list[tuple[str, float]] = []
+
+    def step(name: str):
+        return lambda: done.append((name, time.monotonic() - t0))
+
+    def broken():
+        raise RuntimeError("a step that fails")
+
+    timeline.at(0.3, step("second"))
+    timeline.at(0.1, broken)
+    timeline.at(0.2, step("first"))
+    timeline.at(60.0, step("left"))
+    deadline = time.monotonic() + 10
+    while timeline.pending() > 1 and time.monotonic() < deadline:
+        time.sleep(0.01)
+    assert [name for name, _ in done] == ["first", "second"]
+    assert done[0][1] >= 0.2 and done[1][1] >= 0.3
+    timeline.close()
+    assert [name for name, _ in done] == ["first", "second", "left"]
+    assert timeline.pending() == 0
+
+
+def test_the_final_action_list_waits_for_a_gateway_that_just_came_back():
+    answers = iter([503, 503, 200])
+
+    def gateway(request: httpx.Request) -> httpx.Response:
+        status = next(answers, 200)
+        return httpx.Response(status, json=[] if status == 200 else {"error": "gs unreachable"})
+
+    runner = ChaosRunner(PAPER, ChaosOptions(seed=SEED), Shutdown())
+    client = httpx.Client(base_url="http://gateway", transport=httpx.MockTransport(gateway))
+    assert runner._final(client) == []
+
+
+def test_the_reproduce_line_names_every_option_of_the_run():
+    options = ChaosOptions(seed=4, duration_s=120, drain_s=60, scenario_actions=False, netns=True)
+    assert reproduce(options) == (
+        "linecrew chaos --seed 4 --duration 120 --speedup 10 --drain 60 "
+        "--no-scenario-actions --netns"
+    )
+    assert "--netns" not in reproduce(ChaosOptions(seed=4))
+
+
+def test_netns_refused_is_a_clear_error(monkeypatch, capsys):
+    def refused() -> None:
+        raise NetnsError("network namespaces need `ip netns add`: Operation not permitted")
+
+    monkeypatch.setattr(chaos_main, "check_available", refused)
+    assert chaos_main.main(["--seed", "1", "--netns"]) == 2
+    assert "--netns: network namespaces need `ip netns add`" in capsys.readouterr().err
+
+
+class _Faults:
+    """Records what the runner does to the router, and on which thread."""
+
+    def __init__(self) -> None:
+        self.done: list[tuple[str, float, bool]] = []
+
+    def kill(self, name: str) -> None:
+        self.done.append((f"kill {name}", time.monotonic(), _on_main_thread()))
+
+    def restart(self, name: str):
+        self.done.append((f"restart {name}", time.monotonic(), _on_main_thread()))
+        return types.SimpleNamespace(popen=types.SimpleNamespace(pid=1))
+
+
+def _on_main_thread() -> bool:
+    return threading.current_thread() is threading.main_thread()
+
+
+def test_the_replan_router_kill_follows_the_answer_and_restarts_on_the_main_thread():
+    # a child started off the main thread dies with that thread (PR_SET_PDEATHSIG)
+    kill = next(
+        i
+        for seed in range(40)
+        for i in make_schedule(seed, 120.0, PAPER)
+        if i.kind == "replan_kill_router"
+    )
+    answered: list[float] = []
+
+    def gateway(request: httpx.Request) -> httpx.Response:
+        answered.append(time.monotonic())
+        return httpx.Response(201, json={})
+
+    runner = ChaosRunner(PAPER, ChaosOptions(seed=SEED), Shutdown())
+    runner._t0 = time.monotonic()
+    faults = _Faults()
+    client = httpx.Client(base_url="http://gateway", transport=httpx.MockTransport(gateway))
+    runner._apply(kill, None, faults, client)
+    while runner._heals:
+        due, _, step = heapq.heappop(runner._heals)
+        time.sleep(max(0.0, due - runner._now()))
+        step()
+    (killed, kill_t, kill_main), (restarted, restart_t, restart_main) = faults.done
+    assert (killed, restarted) == ("kill router", "restart router")
+    assert kill_t - answered[0] >= kill.params["kill_after_s"] - 0.01
+    assert restart_t - kill_t >= kill.params["down_s"] - 0.01
+    assert kill_main and restart_main
+    assert list(runner.checker.accepted_at) == [kill.params["action"]["action_id"]]

@@ -1,6 +1,7 @@
-"""Partitions, a ground-station crash and a router crash on real processes
-separated by network namespaces (placement and why: ``tests/chaos/fleet.py``).
-Skipped, with the reason, where ``ip netns add`` is not permitted.
+"""Partitions, a ground-station crash and a router crash on real processes,
+each in a network namespace of its own (placement and why:
+:mod:`linecrew.chaos.netns_run`). Skipped, with the reason, where
+``ip netns add`` is not permitted.
 
 Every wait samples the plans and checks that no piece of work is in two
 UAVs' plans at once (:class:`linecrew.chaos.Checker`)."""
@@ -11,14 +12,16 @@ import time
 from collections.abc import Callable
 from typing import Any
 
+import msgspec
 import pytest
 
-from linecrew.chaos import Checker
+from linecrew.chaos import Checker, main
+from linecrew.chaos.faults import ProcessFaults
+from linecrew.chaos.netns_run import NetnsRun
+from linecrew.launch.local_run import RunOptions
 from linecrew.scenarios import load
 from proto import EventKind, GetHistory, GetSimState, HistoryReply, SimState
 from proto.keys import Role
-from tests.chaos.fleet import ROUTER_PORT, NetnsFleet
-from tests.chaos.netns import network
 
 SPEEDUP = 10.0
 PAPER = load("paper")
@@ -43,9 +46,9 @@ class Watch:
     """REST and simulator views of the fleet, with the invariants checked on
     every look."""
 
-    def __init__(self, fleet: NetnsFleet) -> None:
+    def __init__(self, fleet: NetnsRun) -> None:
         self.fleet = fleet
-        self.http = fleet.gateway()
+        self.http = fleet.http(timeout_s=4.0)
         self.checker = Checker(PAPER.fleet.reserve_fraction)
         self.started = time.monotonic()
 
@@ -124,14 +127,10 @@ class Watch:
 
 
 @pytest.fixture
-def fleet(tmp_path):
-    with network(["ground", "sim", *UAVS]) as net:
-        deployment = NetnsFleet(net, PAPER, tmp_path / "run", SPEEDUP)
-        try:
-            deployment.start()
-            yield deployment
-        finally:
-            deployment.close()
+def fleet(netns, tmp_path):
+    options = RunOptions(speedup=SPEEDUP, run_dir=tmp_path / "run", register=False)
+    with NetnsRun(PAPER, options) as run:
+        yield run
 
 
 def test_partitions_shorter_and_longer_than_the_grace(fleet):
@@ -152,9 +151,9 @@ def test_partitions_shorter_and_longer_than_the_grace(fleet):
     last_seq = watch.history()[-1].seq
 
     # brief: 2 s < the agent's 3 s < the ground station's 5 s
-    fleet.net.block_tcp_port(victim, ROUTER_PORT)
+    fleet.cut(f"agent-{victim}")
     time.sleep(2.0)  # hold the partition
-    fleet.net.unblock(victim)
+    fleet.heal(f"agent-{victim}")
     watch.until(
         f"{victim} still on inspect-long after a brief cut",
         lambda: (
@@ -171,7 +170,7 @@ def test_partitions_shorter_and_longer_than_the_grace(fleet):
     mine = watch.waypoints(victim, "inspect-long")
     assert mine, "the victim holds part of the inspection"
     last_seq = watch.history()[-1].seq
-    fleet.net.block_tcp_port(victim, ROUTER_PORT)
+    fleet.cut(f"agent-{victim}")
     try:
         watch.until(
             f"{victim} lost", lambda: watch.events(EventKind.UAV_LOST, victim, last_seq), 20
@@ -186,7 +185,7 @@ def test_partitions_shorter_and_longer_than_the_grace(fleet):
         watch.until("the victim's waypoints in another UAV's plan", moved, 20)
         watch.until(f"{victim} landed", lambda: watch.truth(victim).state == "landed", 40)
     finally:
-        fleet.net.unblock(victim)
+        fleet.heal(f"agent-{victim}")
     watch.until(f"{victim} back", lambda: watch.events(EventKind.UAV_BACK, victim, last_seq), 20)
     watch.until(
         f"{victim}'s report of its abandoned tasks",
@@ -208,7 +207,7 @@ def test_ground_station_kill_9_and_restart_loses_nothing(fleet):
     for scripted in PAPER.actions:
         if scripted.id == "monitor-w2":
             continue  # seven minutes of monitoring add nothing here
-        body = {**_builtins(scripted.action), "action_id": scripted.id}
+        body = {**msgspec.to_builtins(scripted.action), "action_id": scripted.id}
         body["request_id"] = f"req-{scripted.id}"
         watch.submit(body)
         ids.append(scripted.id)
@@ -218,9 +217,10 @@ def test_ground_station_kill_9_and_restart_loses_nothing(fleet):
         30,
     )
     print({i: watch.state(i) for i in ids})
-    fleet.kill("ground-station")
+    faults = ProcessFaults(fleet)
+    faults.kill("ground-station")
     time.sleep(1.5)  # hold the outage
-    fleet.launch("ground-station")
+    faults.restart("ground-station")
     watch.until(
         "every accepted action listed again",
         lambda: {r["action_id"] for r in watch.get("/v1/actions") or []} >= set(ids),
@@ -236,9 +236,10 @@ def test_ground_station_kill_9_and_restart_loses_nothing(fleet):
 
 def test_router_kill_and_return_everyone_recovers(fleet):
     watch = Watch(fleet)
-    fleet.kill("router")
+    faults = ProcessFaults(fleet)
+    faults.kill("router")
     time.sleep(2.0)  # hold the outage
-    fleet.launch("router")
+    faults.restart("router")
     for uav in UAVS:
         watch.until(f"agent {uav} present", lambda u=uav: fleet.alive(Role.AGENT, u), 30)
     watch.until("ground station present", lambda: fleet.alive(Role.GROUND_STATION, "gs"), 30)
@@ -261,7 +262,37 @@ def test_router_kill_and_return_everyone_recovers(fleet):
     watch.assert_clean()
 
 
-def _builtins(action: Any) -> dict[str, Any]:
-    import msgspec
+# cuts an agent past both graces, the gs at the grace boundary and the gateway,
+# and kills the router right after a new action's answer
+CI_SEED = 44
+LONG_SEEDS = (1, 2, 3)
 
-    return msgspec.to_builtins(action)
+
+def _chaos(tmp_path, capsys, seed: int, duration_s: float, drain_s: float) -> tuple[int, str]:
+    """``linecrew chaos --netns`` on the chaos schedule alone: exit code and report."""
+    args = ["--seed", str(seed), "--duration", f"{duration_s:g}", "--drain", f"{drain_s:g}"]
+    args += ["--speedup", "10", "--no-scenario-actions", "--netns"]
+    code = main([*args, "--run-dir", str(tmp_path / "run")])
+    report = capsys.readouterr().out
+    assert "partitions: real cuts" in report, report
+    assert report.rstrip().endswith("--netns"), report
+    return code, report
+
+
+def test_a_short_netns_chaos_run_reports_zero_violations(netns, tmp_path, capsys):
+    code, report = _chaos(tmp_path, capsys, CI_SEED, 35, 40)
+    for cut in ("partition uav-2 for 9.3 s", "partition ground-station", "partition gateway"):
+        assert "healed at" in report.split(cut)[1].splitlines()[0], report
+    assert "router restarted" in report, report
+    assert "violations: 0" in report, report
+    assert f"reproduce: linecrew chaos --seed {CI_SEED} --duration 35" in report
+    assert code == 0, report
+
+
+@pytest.mark.chaos_long
+@pytest.mark.parametrize("seed", LONG_SEEDS)
+def test_long_netns_chaos_runs_report_zero_violations(netns, tmp_path, capsys, seed):
+    code, report = _chaos(tmp_path, capsys, seed, 120, 150)
+    print(report)
+    assert "violations: 0" in report, report
+    assert code == 0, report

@@ -192,13 +192,13 @@ def test_a_hung_agent_s_replacement_is_not_sent_to_where_it_hovers(truth):
 
     [victim] = truth.until("a UAV watches W2", on_station, 60)
     faults = ProcessFaults(truth.run)
-    faults.freeze(f"agent-{victim}")
+    faults.cut(f"agent-{victim}")  # on loopback: SIGSTOP
     try:
         [relief] = truth.until("another UAV watches W2", lambda: on_station() - {victim}, 90)
         since = truth.samples[-1].sim_s
         truth.until("it holds there 10 s", lambda: truth.samples[-1].sim_s > since + 10, 30)
     finally:
-        faults.thaw_all()
+        faults.heal_all()
     holding = [s for s in truth.samples if s.sim_s > since + 5]
     apart = [math.dist(_xyz(_at(s, victim)), _xyz(_at(s, relief))) for s in holding]
     assert all(relief in truth.watching(s, W2, 4.0, SAFETY.monitor_height_m) for s in holding)
@@ -219,12 +219,12 @@ def test_a_ground_station_frozen_4_s_mid_monitor_ends_with_the_monitor_completed
 
     truth.until("a UAV watches W2", on_station, 60)
     faults = ProcessFaults(truth.run)
-    faults.freeze("ground-station")
+    faults.cut("ground-station")  # on loopback: SIGSTOP
     try:
         frozen_at = truth.samples[-1].sim_s
         truth.until("4 s frozen", lambda: truth.samples[-1].sim_s > frozen_at + 40, 30)
     finally:
-        faults.thaw_all()
+        faults.heal_all()
     truth.until("the monitor ends", lambda: truth.finished(watch), 300)
     record = truth.action(watch)
     assert record["state"] == "completed", record

@@ -1,20 +1,18 @@
-"""Network namespaces for partition tests without Docker.
+"""Network namespaces on one Linux machine, for real link cuts without Docker.
 
 One "switch" namespace holds a bridge; every host namespace gets a veth
 whose other end is a bridge port, with an address ``10.A.B.n/24``; the root
-namespace (the test itself) is plugged in too, as ``10.A.B.254``. Names carry
-a random prefix and the subnet is random, so parallel runs never collide.
+namespace (the observer: the chaos runner or a test) is plugged in too, as
+``10.A.B.254``. Names carry a random prefix and the subnet is random, so
+parallel runs never collide.
 
-Two ways to cut a host off:
+A host is cut off by :meth:`Network.block_port`: an nft table in the host's
+namespace drops TCP to and from one port (the Zenoh router's), except with
+the observer. Only that traffic is cut: an agent keeps its MAVLink link
+(UDP) to the simulated autopilot, and the observer keeps watching.
 
-- :meth:`Network.cut_link` sets its bridge port down: everything is cut;
-- :meth:`Network.block_tcp_port` adds an nft table in the host's namespace
-  that drops TCP to and from one port: only that traffic is cut (used to cut
-  an agent's Zenoh link to the router while its MAVLink link to the
-  simulator, the on-board autopilot, keeps working).
-
-:func:`network` is a context manager that tears everything down in
-``finally``; :func:`require_netns` skips the test with the reason when this
+:func:`network` is a context manager that tears everything down on exit;
+:func:`check_available` raises :class:`NetnsError` with the reason when this
 machine does not allow ``ip netns add`` (not root, no CAP_SYS_ADMIN, no
 ``ip``/``nft``).
 """
@@ -29,28 +27,30 @@ import shutil
 import subprocess
 from collections.abc import Iterator
 
-import pytest
-
 NFT_TABLE = "lcchaos"
+
+
+class NetnsError(RuntimeError):
+    """Network namespaces cannot be used here; the message says why."""
 
 
 def _ip(*args: str) -> None:
     subprocess.run(["ip", *args], check=True, capture_output=True, text=True)
 
 
-def require_netns() -> None:
-    """Skip the calling test, with the reason, unless namespaces and nft work here."""
+def check_available() -> None:
+    """Raise :class:`NetnsError` unless ``ip netns add`` and ``nft`` work here."""
     missing = [tool for tool in ("ip", "nft") if shutil.which(tool) is None]
     if missing:
-        pytest.skip(f"network-namespace partitions need {' and '.join(missing)} (not found)")
+        raise NetnsError(f"network namespaces need {' and '.join(missing)} (not found)")
     probe = f"lcprobe{os.getpid()}"
     try:
-        subprocess.run(["ip", "netns", "add", probe], check=True, capture_output=True, text=True)
+        _ip("netns", "add", probe)
     except subprocess.CalledProcessError as exc:
-        pytest.skip(
-            "network-namespace partitions need `ip netns add` (root or CAP_SYS_ADMIN); "
+        raise NetnsError(
+            "network namespaces need `ip netns add` (root or CAP_SYS_ADMIN); "
             f"here it failed: {exc.stderr.strip() or exc.returncode}"
-        )
+        ) from None
     subprocess.run(["ip", "netns", "del", probe], check=False, capture_output=True)
 
 
@@ -58,7 +58,7 @@ def require_netns() -> None:
 class Host:
     """One host namespace on the switch."""
 
-    name: str  # the caller's name, e.g. "ground"
+    name: str  # the caller's name, e.g. "router" or "uav-1"
     netns: str  # the namespace
     port: str  # its bridge port in the switch namespace
     address: str  # 10.A.B.n
@@ -66,7 +66,7 @@ class Host:
 
 @dataclasses.dataclass
 class Network:
-    """A switch and its hosts; the root namespace is at ``root_address``."""
+    """A switch and its hosts; the observer (root namespace) is at ``root_address``."""
 
     prefix: str
     subnet: str  # "10.A.B"
@@ -75,13 +75,13 @@ class Network:
 
     @property
     def root_address(self) -> str:
-        """Where the test itself sits on the switch."""
+        """Where the observer sits on the switch."""
         return f"{self.subnet}.254"
 
     def add_host(self, name: str) -> Host:
-        """A new namespace ``name`` plugged into the switch."""
+        """A new namespace for ``name`` plugged into the switch."""
         index = len(self.hosts) + 1
-        host = Host(name, f"{self.prefix}-{name}", f"{self.prefix}p{index}", "")
+        host = Host(name, f"{self.prefix}-{index}", f"{self.prefix}p{index}", "")
         host.address = f"{self.subnet}.{index}"
         _ip("netns", "add", host.netns)
         self.hosts[name] = host
@@ -99,35 +99,29 @@ class Network:
         """The command prefix that runs a program inside host ``name``."""
         return ["ip", "netns", "exec", self.hosts[name].netns]
 
-    def cut_link(self, name: str) -> None:
-        """Everything to and from ``name`` is cut (its bridge port goes down)."""
-        _ip("-n", self.switch, "link", "set", self.hosts[name].port, "down")
-
-    def restore_link(self, name: str) -> None:
-        """Undo :meth:`cut_link`."""
-        _ip("-n", self.switch, "link", "set", self.hosts[name].port, "up")
-
-    def block_tcp_port(self, name: str, port: int) -> None:
-        """Drop TCP to and from ``port`` inside host ``name`` (both directions)."""
+    def block_port(self, name: str, port: int) -> None:
+        """Drop TCP to and from ``port`` inside host ``name`` (either end, both
+        directions), except with the observer."""
+        root, table = self.root_address, f"inet {NFT_TABLE}"
         rules = (
-            f"add table inet {NFT_TABLE}\n"
-            f"add chain inet {NFT_TABLE} out {{ type filter hook output priority 0; }}\n"
-            f"add chain inet {NFT_TABLE} in {{ type filter hook input priority 0; }}\n"
-            f"add rule inet {NFT_TABLE} out tcp dport {port} drop\n"
-            f"add rule inet {NFT_TABLE} in tcp sport {port} drop\n"
+            f"add table {table}\n"
+            f"add chain {table} out {{ type filter hook output priority 0; }}\n"
+            f"add chain {table} in {{ type filter hook input priority 0; }}\n"
+            f"add rule {table} out ip daddr != {root} tcp dport {port} drop\n"
+            f"add rule {table} out ip daddr != {root} tcp sport {port} drop\n"
+            f"add rule {table} in ip saddr != {root} tcp dport {port} drop\n"
+            f"add rule {table} in ip saddr != {root} tcp sport {port} drop\n"
         )
-        subprocess.run(
-            [*self.exec_prefix(name), "nft", "-f", "-"],
-            input=rules,
-            check=True,
-            capture_output=True,
-            text=True,
-        )
+        self._nft(name, ["-f", "-"], rules)
 
     def unblock(self, name: str) -> None:
-        """Undo :meth:`block_tcp_port`."""
+        """Undo :meth:`block_port`."""
+        self._nft(name, ["delete", "table", "inet", NFT_TABLE])
+
+    def _nft(self, name: str, args: list[str], script: str | None = None) -> None:
         subprocess.run(
-            [*self.exec_prefix(name), "nft", "delete", "table", "inet", NFT_TABLE],
+            [*self.exec_prefix(name), "nft", *args],
+            input=script,
             check=True,
             capture_output=True,
             text=True,
@@ -143,8 +137,9 @@ class Network:
 
 @contextlib.contextmanager
 def network(hosts: list[str]) -> Iterator[Network]:
-    """A switch with ``hosts`` and the root namespace on it; torn down on exit."""
-    require_netns()
+    """A switch with ``hosts`` and the observer on it; torn down on exit.
+    Raises :class:`NetnsError` where namespaces are not permitted."""
+    check_available()
     rng = random.Random()
     prefix = f"lc{rng.randrange(16**5):05x}"
     net = Network(prefix, f"10.{rng.randint(100, 250)}.{rng.randint(0, 255)}", f"{prefix}-sw")
