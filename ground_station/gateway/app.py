@@ -9,7 +9,7 @@ import uuid
 from collections.abc import Awaitable, Callable
 from typing import Any
 
-from fastapi import FastAPI, Path, Query, Request, Response
+from fastapi import Depends, FastAPI, Path, Query, Request, Response
 from fastapi.exceptions import RequestValidationError
 from fastapi.responses import PlainTextResponse, StreamingResponse
 from fastapi_offline import FastAPIOffline
@@ -29,6 +29,7 @@ from ground_station.gateway.errors import (
     decode_body,
     error_response,
     http_error_handler,
+    known_query_only,
     linecrew_error_handler,
     validation_error_handler,
 )
@@ -90,6 +91,7 @@ def create_app(
         version="1",
         description="Operator API of a linecrew ground station.",
         redoc_url=None,
+        dependencies=[Depends(known_query_only)],
     )
     counters = GatewayCounters()
     app.add_exception_handler(LinecrewError, linecrew_error_handler)

@@ -82,6 +82,17 @@ async def validation_error_handler(_request: Request, exc: Exception) -> JSONRes
     return error_response("invalid_request", first.get("msg", "invalid request"), field)
 
 
+def known_query_only(request: Request) -> None:
+    """Refuse a query parameter the operation does not take (a typo would
+    otherwise be ignored silently): 422 naming it."""
+    dependant = getattr(request.scope.get("route"), "dependant", None)
+    allowed = {p.alias for p in dependant.query_params} if dependant is not None else set()
+    unknown = sorted(set(request.query_params) - allowed)
+    if unknown:
+        name = unknown[0]
+        raise HttpError("invalid_request", f"unknown query parameter {name!r}", field=name)
+
+
 def decode_body(body: bytes, body_type: type) -> object:
     """Decode a JSON body; a bad one is a 422 naming the field."""
     try:
