@@ -1,14 +1,14 @@
-"""Freeze one process of a running fleet for a block (SIGSTOP, then SIGCONT
-whatever happens): it falls silent exactly as if its link were cut."""
+"""Freeze one process of a running fleet for a block (the chaos runner's
+partition of a loopback run: SIGSTOP, then SIGCONT whatever happens): it
+falls silent exactly as if its link were cut."""
 
 from __future__ import annotations
 
 import contextlib
-import os
-import signal
 import time
 from collections.abc import Iterator
 
+from linecrew.chaos.faults import ProcessFaults
 from linecrew.launch.local_run import LocalRun
 
 
@@ -16,10 +16,9 @@ from linecrew.launch.local_run import LocalRun
 def frozen(run: LocalRun, name: str) -> Iterator[float]:
     """Stop ``run``'s child ``name`` (e.g. ``agent-uav-1``) for the block;
     yields the monotonic time it was stopped."""
-    child = next(c for c in reversed(run.supervisor.children) if c.name == name)
-    os.kill(child.popen.pid, signal.SIGSTOP)
+    faults = ProcessFaults(run)
+    faults.cut(name)
     try:
         yield time.monotonic()
     finally:
-        with contextlib.suppress(ProcessLookupError):
-            os.kill(child.popen.pid, signal.SIGCONT)
+        faults.heal(name)
