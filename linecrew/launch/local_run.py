@@ -32,7 +32,9 @@ from linecrew.launch import secure
 from linecrew.launch.flight_log import FlightLog
 from linecrew.launch.ports import free_udp_block
 from linecrew.launch.supervisor import Child, Supervisor
+from proto.errors import LinecrewError
 from proto.keys import KeySpace, Role
+from proto.rpc import FleetReply, GetFleet
 from proto.scenario import Scenario
 
 log = logging.getLogger(__name__)
@@ -203,6 +205,7 @@ class LocalRun:
             self.session_file = session.register(entry, opts.session_file)
 
         self._start_agents(uavs, base_port, common, profile)
+        sup.wait_ready(gs, lambda: self.fleet_heard(uavs), wait)
         log.info("all processes healthy", extra={"run_dir": str(self.run_dir)})
 
     def _start_agents(
@@ -250,6 +253,24 @@ class LocalRun:
         assert self.bus is not None
         key = self.keys.all_alive(Role.AGENT)
         return {self.keys.alive(Role.AGENT, u) for u in uavs} <= self.bus.alive(key, 0.5)
+
+    def fleet_heard(self, uavs: list[str]) -> bool:
+        """Whether the ground station has heard every UAV's agent and (unless
+        the autopilots warm up on purpose: no position, not ready yet) its
+        telemetry and readiness: work asked for as soon as the run is up is
+        planned on the whole fleet, not on the UAVs heard first."""
+        assert self.bus is not None
+        try:
+            reply = self.bus.query(self.keys.rpc("fleet"), GetFleet(), FleetReply, 2.0)
+        except LinecrewError:
+            return False
+        warming = self.options.warmup_s is not None
+        heard = {
+            u.uav_id
+            for u in reply.uavs
+            if u.status is not None and (warming or (u.telemetry is not None and u.status.ready))
+        }
+        return set(uavs) <= heard
 
     def _describe(self, started_s: float) -> None:
         """``run.json``: what ``linecrew report`` needs to know of the run."""
