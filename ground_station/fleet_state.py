@@ -70,6 +70,26 @@ def running_action(monitor: FleetMonitor, plan: Plan | None, in_force: set[str])
     return None
 
 
+def flying_segments(
+    monitor: FleetMonitor, plans: dict[str, Plan], in_force: set[str]
+) -> dict[str, MonitorTask]:
+    """The monitoring segments of actions in force that their UAVs report
+    flying now, by task id."""
+    flying: dict[str, MonitorTask] = {}
+    for uav_id, plan in plans.items():
+        status = monitor.status(uav_id)
+        if status is None or status.task_id is None:
+            continue
+        for task in plan.tasks:
+            if (
+                task.task_id == status.task_id
+                and isinstance(task, MonitorTask)
+                and task.action_id in in_force
+            ):
+                flying[task.task_id] = task
+    return flying
+
+
 def drop_done_home(
     docks: Docks, monitor: FleetMonitor, uav_id: str, tasks: list[Task]
 ) -> list[Task]:

@@ -67,6 +67,14 @@ def _xyz(p: Point, above_m: float = 0.0) -> tuple[float, float, float]:
     return (p.x_m, p.y_m, p.z_m + above_m)
 
 
+def flown_s(segment: MonitorTask, at_s: float) -> float:
+    """Seconds of its planned window a monitoring segment being flown has
+    behind it at ``at_s`` (the agent counts its time on station within the
+    window, so this is what it reports if it arrived in time)."""
+    begin = segment.end_s - segment.duration_s
+    return min(max(0.0, at_s - begin), segment.duration_s)
+
+
 def build_problem(
     site: Site,
     fleet: Fleet,
@@ -75,11 +83,20 @@ def build_problem(
     now_s: float,
     worker_positions: dict[str, Point] | None = None,
     monitor_starts: dict[str, float] | None = None,
+    flying: Iterable[MonitorTask] = (),
 ) -> pl.Problem:
     """The planner's view of the mission at ``now_s`` (mission seconds).
     ``monitor_starts`` holds the synchronised starts (mission seconds)
-    already promised for monitoring actions; future ones are kept if feasible."""
+    already promised for monitoring actions; future ones are kept if feasible.
+    ``flying`` are the monitoring segments being flown: what they have
+    flown is no longer asked of the plan (only ended segments are in a
+    record's ``monitored_s``), so a replan never starts a watch over."""
     workers = {w.id: w.position for w in site.workers} | (worker_positions or {})
+    behind: dict[str, float] = {}
+    for segment in flying:
+        if segment.action_id is not None:
+            share = flown_s(segment, now_s) / segment.slots
+            behind[segment.action_id] = behind.get(segment.action_id, 0.0) + share
     specs = {u.id: u for u in fleet.uavs}
     safety = site.safety
     return pl.Problem(
@@ -130,7 +147,10 @@ def build_problem(
             )
             for u in uavs
         ),
-        actions=tuple(_action(r, workers, safety, now_s, monitor_starts or {}) for r in records),
+        actions=tuple(
+            _action(r, workers, safety, now_s, monitor_starts or {}, behind.get(r.action_id, 0.0))
+            for r in records
+        ),
     )
 
 
@@ -140,9 +160,12 @@ def _action(
     safety: Safety,
     now_s: float,
     monitor_starts: dict[str, float],
+    flying_s: float,
 ) -> pl.Action:
     """The planner's action; a delivery's ``worker_m`` is its drop point,
-    ``DROP_HEIGHT_M`` above the worker, where the agent releases the tool."""
+    ``DROP_HEIGHT_M`` above the worker, where the agent releases the tool; a
+    monitor's duration is what is left of it (``flying_s``: flown in the
+    segments being flown)."""
     action = record.action
     common = {
         "id": record.action_id,
@@ -167,7 +190,7 @@ def _action(
                 standoff_m=action.standoff_m,
                 height_m=safety.monitor_height_m,
                 bearing_deg=action.bearing_deg or 0.0,
-                duration_s=max(1.0, action.duration_s - record.monitored_s),
+                duration_s=max(1.0, action.duration_s - record.monitored_s - flying_s),
                 start_s=_promised(monitor_starts.get(record.action_id), now_s),
             )
         case DeliverAction():
@@ -205,8 +228,12 @@ def to_tasks(
     fleet: Fleet,
     records: dict[str, ActionRecord],
     now_s: float,
+    flying: dict[str, MonitorTask] | None = None,
 ) -> list[Task]:
-    """One UAV's planner steps as wire tasks (absolute mission seconds)."""
+    """One UAV's planner steps as wire tasks (absolute mission seconds). A
+    segment that goes on one of ``flying`` (by task id) keeps its window's
+    start: its duration counts what was flown before ``now_s`` too, so the
+    agent ends it, and the ground station credits it, as one segment."""
     capacity = fleet.type_of(uav_plan.uav_id).battery_wh
     stations = {s.id: s for s in site.stations}
     tasks: list[Task] = []
@@ -250,11 +277,14 @@ def to_tasks(
             )
             i = j + 1
             continue
-        tasks.append(
-            _simple_task(
-                step, record, uav_plan.uav_id, stations, site.safety, capacity, counts, times
-            )
+        task = _simple_task(
+            step, record, uav_plan.uav_id, stations, site.safety, capacity, counts, times
         )
+        going_on = (flying or {}).get(task.task_id)
+        if isinstance(task, MonitorTask) and going_on is not None:
+            duration = task.duration_s + flown_s(going_on, now_s)
+            task = msgspec.structs.replace(task, duration_s=duration)
+        tasks.append(task)
         i += 1
     return _lead_departures(tasks)
 

@@ -12,7 +12,7 @@ from ground_station.lifecycle import ActionEvent
 from ground_station.live_plan import Candidate
 from ground_station.planning import UavNow
 from proto.mission import ActionRecord
-from proto.plan import Plan, Task
+from proto.plan import MonitorTask, Plan, Task
 
 
 @dataclasses.dataclass
@@ -53,6 +53,7 @@ class Job:
     uavs: list[UavNow]
     starts: dict[str, float]
     version: int
+    flying: dict[str, MonitorTask] = dataclasses.field(default_factory=dict)  # segments flown now
     frozen: dict[str, list[Task]] | None = None  # improvement: tasks that must stay
 
 

@@ -17,7 +17,7 @@ import msgspec
 from ground_station import planner as pl
 from ground_station.event_log import EventLog
 from ground_station.fleet_monitor import FleetMonitor
-from ground_station.fleet_state import AIRBORNE, Docks, drop_done_home, uavs_now
+from ground_station.fleet_state import AIRBORNE, Docks, drop_done_home, flying_segments, uavs_now
 from ground_station.lifecycle import ActionEvent
 from ground_station.live_plan import (
     LivePlan,
@@ -159,6 +159,7 @@ class Replanner:
             ),
             starts=monitor_starts(self.plans.values()),
             version=self.version,
+            flying=flying_segments(self.monitor, self.plans, in_force),
         )
 
     def compute(self, job: Job) -> Computed:
@@ -168,7 +169,13 @@ class Replanner:
 
         def build(base_s: float) -> pl.Problem:
             return build_problem(
-                site, fleet, job.uavs, job.records, base_s, monitor_starts=job.starts
+                site,
+                fleet,
+                job.uavs,
+                job.records,
+                base_s,
+                monitor_starts=job.starts,
+                flying=job.flying.values(),
             )
 
         started = time.perf_counter()
@@ -183,16 +190,18 @@ class Replanner:
         elapsed = time.perf_counter() - started
         return Computed(
             job,
-            self._wire(planned.plan, job.records, planned.base_s),
+            self._wire(planned.plan, job, planned.base_s),
             result=planned.plan,
             elapsed_s=elapsed,
             incremental=planned.incremental,
         )
 
-    def _wire(self, result: pl.Plan, records: list[ActionRecord], base_s: float) -> dict:
+    def _wire(self, result: pl.Plan, job: Job, base_s: float) -> dict:
         site, fleet = self.scenario.site, self.scenario.fleet
-        by_id = {r.action_id: r for r in records}
-        return {up.uav_id: to_tasks(up, site, fleet, by_id, base_s) for up in result.uavs}
+        by_id = {r.action_id: r for r in job.records}
+        return {
+            up.uav_id: to_tasks(up, site, fleet, by_id, base_s, job.flying) for up in result.uavs
+        }
 
     def commit(self, computed: Computed) -> ReplanOutcome | None:
         """Adopt a computed plan (on the loop): a new epoch for the UAVs whose
@@ -321,7 +330,7 @@ class Replanner:
         )
         if candidate is None:
             return None
-        tasks = self._wire(candidate.plan, job.records, candidate.base_s)
+        tasks = self._wire(candidate.plan, job, candidate.base_s)
         return Computed(
             job,
             tasks,

@@ -21,6 +21,7 @@ from proto import (
     MonitorAction,
     MonitorTask,
     OutcomeResult,
+    Point,
     SubmitAction,
     TaskOutcome,
     WaitTask,
@@ -387,3 +388,46 @@ def test_an_outcome_under_an_older_epoch_still_counts_for_a_task_carried_over(gs
     )
     gs.settle()
     assert gs.store.action("watch").state == ActionState.COMPLETED
+
+
+def on_station(gs: Harness, uav_id: str, segment: MonitorTask, at: Point) -> None:
+    """``uav_id`` hovers at ``at`` and reports flying ``segment``."""
+    flying = msgspec.structs.replace(
+        gs.telemetry(uav_id), position=at, flight_state=FlightState.FLYING
+    )
+    gs.monitor.on_telemetry(flying, gs.now)
+    status = AgentStatus(
+        uav_id=uav_id,
+        stamp_s=gs.now,
+        state=AgentState.BUSY,
+        epoch=gs.replanner.plans[uav_id].epoch,
+        task_id=segment.task_id,
+        progress=0.5,
+    )
+    gs.monitor.on_status(status, gs.now)
+
+
+def test_a_replan_while_a_segment_is_flown_neither_starts_the_watch_over_nor_extends_it(gs):
+    """A replan in the middle of a segment (here: a task of another action
+    finished) plans only what is left of the watch: the segment keeps its
+    window and its UAV is not told to stay longer (it was told to watch
+    from scratch, 90 s more than asked, whenever anything replanned)."""
+    submit(gs, MonitorAction(worker_id="W2", uavs=1, standoff_m=4, duration_s=90), "watch")
+    uav, segment = next(
+        (u, t) for u in ALL for t in gs.replanner.plans[u].tasks if isinstance(t, MonitorTask)
+    )
+    begin = segment.end_s - segment.duration_s
+    gs.now = begin + 40.0
+    slot = Point(x_m=-1.0, y_m=15.0, z_m=6.0)  # W2 at (-5, 15, 3): 4 m east, 3 m above
+    on_station(gs, uav, segment, slot)
+    gs.manager.replan("another action's task finished")
+    [going_on] = [t for t in gs.replanner.plans[uav].tasks if isinstance(t, MonitorTask)]
+    assert going_on.task_id == segment.task_id
+    assert going_on.end_s == pytest.approx(segment.end_s, abs=2.0)
+    assert going_on.end_s - going_on.duration_s == pytest.approx(begin, abs=2.0)
+    others = [t for u in ALL if u != uav for t in gs.replanner.plans[u].tasks]
+    assert not [t for t in others if isinstance(t, MonitorTask)], "nobody else is needed"
+    outcome(gs, uav, going_on, flown_s=90.0)
+    record = gs.store.action("watch")
+    assert record.state == ActionState.COMPLETED
+    assert record.monitored_s == pytest.approx(90.0)
