@@ -6,12 +6,15 @@ from __future__ import annotations
 import argparse
 import asyncio
 import contextlib
+import logging
 import os
 import signal
 import threading
 
 from linecrew.bus import BusConfig
 from linecrew.logs import configure_logging
+
+log = logging.getLogger(__name__)
 
 
 def common_parser(prog: str, description: str) -> argparse.ArgumentParser:
@@ -52,6 +55,13 @@ def start(args: argparse.Namespace, process: str, mode: str = "client") -> BusCo
 
 WAIT_SLICE_S = 0.2
 """How long the main thread sleeps at a time while it waits for a signal."""
+DEADLINE_S = 20.0
+"""A process still running this long after a signal asked it to stop exits at
+once: a close that hangs must not leave it running with nobody to stop it
+(children of a killed ``linecrew up`` are asked by the kernel, and a
+supervisor that is alive kills its children after 10 s anyway)."""
+EXIT_OVERDUE = 70
+"""The exit code of a process that did not stop within ``DEADLINE_S``."""
 
 
 class Shutdown:
@@ -59,7 +69,8 @@ class Shutdown:
 
     SIGNALS = (signal.SIGINT, signal.SIGTERM)
 
-    def __init__(self) -> None:
+    def __init__(self, deadline_s: float | None = DEADLINE_S) -> None:
+        self.deadline_s = deadline_s
         self._event = threading.Event()
         self._loop: asyncio.AbstractEventLoop | None = None
         self._async_event: asyncio.Event | None = None
@@ -72,6 +83,12 @@ class Shutdown:
         return self
 
     def _on_signal(self, signum: int, _frame: object) -> None:
+        """A signal asks for shutdown; the process exits by force if it is
+        still running ``deadline_s`` later."""
+        if not self._event.is_set() and self.deadline_s is not None:
+            timer = threading.Timer(self.deadline_s, self._overdue)
+            timer.daemon = True
+            timer.start()
         self.signal_name = signal.Signals(signum).name
         self.request()
 
@@ -85,6 +102,11 @@ class Shutdown:
         if self._loop is not None and self._async_event is not None:
             with contextlib.suppress(RuntimeError):  # loop already closed
                 self._loop.call_soon_threadsafe(self._async_event.set)
+
+    def _overdue(self) -> None:
+        log.error("still running %.0f s after shutdown was asked for; exiting now", self.deadline_s)
+        logging.shutdown()
+        os._exit(EXIT_OVERDUE)
 
     def wait(self, timeout_s: float | None = None) -> bool:
         """Block until shutdown is requested (or the timeout passes). Waits in

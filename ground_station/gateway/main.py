@@ -27,6 +27,10 @@ from proto.telemetry import HumanPose
 
 log = logging.getLogger("linecrew.gateway")
 
+STREAMS_GRACE_S = 3.0
+"""On SIGTERM, open requests (an event stream never ends by itself) get this
+long before they are cut and the gateway exits."""
+
 
 def main(argv: list[str] | None = None) -> int:
     """Serve HTTP until SIGINT/SIGTERM; exit 1 on a fatal start-up error."""
@@ -75,6 +79,7 @@ def main(argv: list[str] | None = None) -> int:
                 access_log=False,
                 ssl_certfile=args.tls_cert,
                 ssl_keyfile=args.tls_key,
+                timeout_graceful_shutdown=STREAMS_GRACE_S,
             )
         )
         scheme = "https" if args.tls_cert else "http"

@@ -111,5 +111,8 @@ def test_a_killed_up_takes_its_children_with_it(up):
     kids = children(proc.popen.pid)
     assert survivors(run_dir) and len(kids) >= 5  # router, gs, sim, gateway, agents
     os.kill(proc.popen.pid, signal.SIGKILL)
-    wait_until(lambda: not survivors(run_dir), 30, "children gone after SIGKILL of up")
+    try:
+        wait_until(lambda: not survivors(run_dir), 30, "children gone after SIGKILL of up")
+    except AssertionError as late:
+        raise AssertionError(f"{late}; still running: {survivors(run_dir)}") from None
     wait_until(lambda: not alive(kids), 30, "the router gone too")

@@ -31,8 +31,8 @@ def gs(router, bus_config, tmp_path):
 
 
 @pytest.fixture
-def gateway_url(router, gs):
-    """A running gateway process; yields its base URL."""
+def gateway_process(router, gs):
+    """A running gateway process; yields it and its base URL."""
     port = free_port()
     args = [
         sys.executable,
@@ -55,8 +55,14 @@ def gateway_url(router, gs):
         except httpx.HTTPError:
             return False
 
-    with running(args, "gateway", healthy):
-        yield base
+    with running(args, "gateway", healthy) as proc:
+        yield proc, base
+
+
+@pytest.fixture
+def gateway_url(gateway_process):
+    """The base URL of a running gateway process."""
+    return gateway_process[1]
 
 
 @pytest.fixture

@@ -5,12 +5,17 @@ the ground station is gone."""
 from __future__ import annotations
 
 import json
+import signal
+import subprocess
+import threading
 
 import httpx
 import pytest
 
+from ground_station.gateway.main import STREAMS_GRACE_S
 from linecrew.bus import Bus
 from proto import EventKind, GsEvent, KeySpace
+from tests.ground_station.gateway.conftest import TOKEN
 from tests.support.processes import wait_until
 
 DELIVER = {"type": "deliver", "tool": "wrench", "tool_station_id": "tp-wrench", "worker_id": "W1"}
@@ -192,3 +197,31 @@ def test_the_framework_s_own_errors_come_in_the_documented_shape(
     body = response.json()
     assert response.status_code == status and set(body) >= {"error", "message", "field"}, body
     assert (body["error"], body["field"]) == (error, field) and "detail" not in body
+
+
+def test_an_open_event_stream_does_not_keep_the_gateway_from_stopping(gateway_process):
+    """An event stream never ends by itself: on SIGTERM the gateway cuts it
+    after its grace and exits (it waited for it forever, so a killed
+    ``linecrew up`` left its gateway running)."""
+    proc, base = gateway_process
+    opened, ended = threading.Event(), threading.Event()
+
+    def follow() -> None:
+        headers = {"Authorization": f"Bearer {TOKEN}"}
+        try:
+            with httpx.stream("GET", f"{base}/v1/events", headers=headers, timeout=None) as r:
+                opened.set()
+                for _line in r.iter_lines():
+                    pass
+        except httpx.HTTPError:
+            pass
+        ended.set()
+
+    threading.Thread(target=follow, daemon=True).start()
+    wait_until(opened.is_set, 10, "the stream open")
+    proc.popen.send_signal(signal.SIGTERM)
+    try:
+        proc.popen.wait(STREAMS_GRACE_S + 15)
+    except subprocess.TimeoutExpired:
+        raise AssertionError("the gateway still runs with a stream open") from None
+    wait_until(ended.is_set, 10, "the stream cut")
