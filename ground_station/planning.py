@@ -105,6 +105,7 @@ def build_problem(
         min_altitude_m=safety.ground_z_m + safety.min_altitude_m,
         separation_m=safety.separation_m,
         end=fleet.end.value,
+        takeoff_s=TAKEOFF_LEAD_S,
         stations=tuple(
             pl.Station(
                 id=s.id,

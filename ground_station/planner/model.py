@@ -213,3 +213,8 @@ class Problem(msgspec.Struct, frozen=True, kw_only=True):
     end: End = "home"
     """End-of-mission policy (``End``), reached with as many recharges on the
     way as needed; the validator reports ``not_home`` / ``end_station``."""
+    takeoff_s: float = 0.0
+    """Seconds a UAV on the ground needs before it flies (arming, take-off,
+    climb). Legs are flown as if it took none; only a synchronised
+    monitoring start counts it, so that a UAV leaving a pad for the ring is
+    there when the watch begins."""

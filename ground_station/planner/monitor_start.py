@@ -36,7 +36,8 @@ class ReadyTimes:
     Evaluated lazily in order of ``bound``, a lower bound of when the UAV can
     start a segment there (direct flight; a direct flight with the battery
     for ``min_seg_s`` is exact), so only UAVs that may be among the earliest
-    are simulated.
+    are simulated. A UAV that leaves a pad first (landed, or after a
+    recharge) is ready ``Problem.takeoff_s`` later.
     """
 
     def __init__(
@@ -44,13 +45,17 @@ class ReadyTimes:
     ) -> None:
         self._ctx, self.base, self._duration_s = ctx, base, a.duration_s
         self._min_seg_s = min_seg_s
+        self._takeoff_s = ctx.problem.takeoff_s
         self._pos = pos = slot_position(a, 0)
         self.bound: dict[str, float] = {}
         self._direct: set[str] = set()  # can come now for at least ``min_seg_s``
         self._heap: list[tuple[float, bool, str]] = []
         for uid in uids:
             r = ctx.routes[uid]
-            arr, e_at = direct_arrival(r.kin, r.tail(), pos, base)
+            st = r.tail()
+            arr, e_at = direct_arrival(r.kin, st, pos, base)
+            if st.landed:
+                arr += self._takeoff_s
             self.bound[uid] = arr
             self._heap.append((arr, False, uid))
             if e_at >= hold_floor_wh(r.kin, ctx.site, pos, min_seg_s):
@@ -67,8 +72,11 @@ class ReadyTimes:
         leg_wh = hold_floor_wh(k, ctx.site, self._pos, 0.0) - k.reserve_wh
         usable_wh = k.capacity_wh - 2 * leg_wh - k.reserve_wh
         hold_s = min(self._duration_s, HOLD_SHARE * usable_wh / max(k.hover_whps, 1e-12))
+        direct = direct_arrival(k, st, self._pos, self.base)[0]
         for need_s in (hold_s, self._min_seg_s):
             t = monitor_ready(k, ctx.site, ctx.pads, st, self._pos, self.base, (uid, st.t), need_s)
+            if t is not None and (st.landed or t > direct + 1e-9):  # leaves a pad first
+                t += self._takeoff_s
             if t is not None or need_s <= self._min_seg_s:
                 return t
         return None

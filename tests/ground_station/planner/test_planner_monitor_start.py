@@ -2,6 +2,9 @@
 
 from __future__ import annotations
 
+import msgspec
+import pytest
+
 from ground_station.planner import (
     InspectAction,
     MonitorAction,
@@ -73,3 +76,28 @@ def test_monitoring_starts_after_recharge_first_not_at_the_fleets_last_finish() 
     assert t0 <= ready + 1.0
     assert t0 < inspect_end
     assert [s.kind for s in steps["U1"]][:2] == ["recharge", "monitor"]
+
+
+def test_a_synchronised_start_leaves_the_take_off_time_to_a_uav_on_a_pad() -> None:
+    """Two landed UAVs watch one worker together: the start is their flight
+    time plus ``takeoff_s`` (the live fleet's UAVs arrived 5-10 s into the
+    window, having armed and climbed in time the plan did not count)."""
+    station = Station(id="S", position_m=(0.0, 0.0, 0.0))
+    uavs = tuple(
+        Uav(id=u, type="safety", position_m=(0.0, 0.0, 0.0), home_station="S", energy_wh=60.0)
+        for u in ("U1", "U2")
+    )
+    watch = MonitorAction(id="watch", worker_m=(100.0, 0.0, 0.0), k=2, duration_s=120.0)
+    base = Problem(stations=(station,), uav_types=(SAFETY,), uavs=uavs, actions=(watch,))
+
+    def start(problem: Problem) -> float:
+        result = plan(problem)
+        assert validate(problem, result) == []
+        segments = [s for u in result.uavs for s in u.steps if s.kind == "monitor"]
+        assert len(segments) == 2
+        return max(s.end_s - 120.0 for s in segments)
+
+    flight = start(base)
+    assert flight >= 100.0 / 10.0 - 4.0  # about 10 s at 10 m/s to the ring
+    later = start(msgspec.structs.replace(base, takeoff_s=8.0))
+    assert later == pytest.approx(flight + 8.0, abs=0.5)
