@@ -186,8 +186,17 @@ def test_a_hung_agent_s_replacement_is_not_sent_to_where_it_hovers(truth):
     watch = truth.submit(monitor("W2", 1, 240))["action_id"]
 
     def on_station() -> set[str]:
-        """UAVs at W2's ring for the watch (another may only be flying past)."""
-        ring = truth.watching(truth.samples[-1], W2, 4.0, SAFETY.monitor_height_m)
+        """UAVs hovering at W2's ring for the watch: there in the last two
+        samples, 2 s or more apart, within 1 m of where they were (another
+        may only be flying past: a relief sent to the far side of W2 crosses
+        the ring on its way)."""
+        last = truth.samples[-1]
+        before = [s for s in truth.samples if s.sim_s <= last.sim_s - 2.0]
+        if not before:
+            return set()
+        ring = truth.watching(last, W2, 4.0, SAFETY.monitor_height_m)
+        ring &= truth.watching(before[-1], W2, 4.0, SAFETY.monitor_height_m)
+        ring = {u for u in ring if math.dist(_xyz(_at(last, u)), _xyz(_at(before[-1], u))) < 1.0}
         return ring & truth.working_on(watch) if ring else ring
 
     [victim] = truth.until("a UAV watches W2", on_station, 60)
