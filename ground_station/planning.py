@@ -56,8 +56,11 @@ judge "battery enough" with a safety factor (``energy_margin``) over the
 next step and the way to a station; a plan that ran to the bare reserve
 would make them leave a slot or skip a waypoint half a minute early, before
 the relief the plan sent. 3 % covers that factor on the paper's fleet."""
-TAKEOFF_LEAD_S = 8.0
-"""Seconds a UAV leaves early for a monitoring segment (arming, take-off, climb)."""
+TAKEOFF_LEAD_S = 12.0
+"""Seconds a UAV leaves early for a monitoring segment (arming, take-off,
+climb), and the planner's ``takeoff_s``. Measured on the simulated fleet at
+x10: leaving the pad for W2's ring took 6-7 s more than the straight flight
+the planner counts, and arming 1-3 s before that."""
 DROP_HEIGHT_M = 2.0
 """Height above the worker at which a tool is released (the agent's
 ``deliver_height_m`` default)."""
