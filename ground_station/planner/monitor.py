@@ -7,6 +7,8 @@ Each slot is covered by a chain of segments: when a UAV's battery forces it
 to leave, another UAV arrives at or before that moment and takes the slot
 (the paper's Fig. 6), so coverage has no gap. Segments are tasks anchored
 at their start time; the UAV that left recharges in its own route.
+A start promised by an earlier plan stands unless one ``EARLIER_S``
+sooner is possible now.
 An action some of whose segments stay planned (an improvement ruins the
 rest but never moves a frozen one) gets only its slots without one.
 """
@@ -36,6 +38,10 @@ uniform random fraction in this range of its reach), so a UAV can leave
 early for other work."""
 SHUFFLE_P = 0.2
 """Improvement only: the chance that segment candidates are tried in random order."""
+EARLIER_S = 30.0
+"""A promised start (``MonitorAction.start_s``) stands unless the action
+can start at least this much earlier now (a UAV came back or was freed):
+small gains never move a start the UAVs are already flying to."""
 
 
 def _cover(
@@ -218,16 +224,18 @@ def place_monitor(ctx: Ctx, a: MonitorAction) -> None:
         ctx.add_unplaced(a.id, None, "unreachable_with_full_battery")
         return
     base = max(a.release_s, ctx.problem.now_s)
-    if a.start_s is not None and a.start_s >= base and _keep_start(ctx, a, uids):
-        return
     ready = ReadyTimes(ctx, a, uids, base, min_seg)
     t0 = ready.nth(a.k - 1)
+    promised = a.start_s if a.start_s is not None and a.start_s >= base else None
+    keep = promised is not None and (t0 is None or t0 > promised - EARLIER_S)
+    if keep and _keep_start(ctx, a, uids):
+        return
     if t0 is None:
         ctx.add_unplaced(a.id, None, "monitor_coverage_infeasible")
         return
     primary, fallback = start_times(ctx, a, ready, t0)
     snap = ctx.snapshot()
-    best: tuple[float, tuple] | None = None
+    best: tuple[float, float, tuple] | None = None
     tried: set[float] = set()
     for group in (primary, fallback):
         for t in group:
@@ -236,13 +244,15 @@ def place_monitor(ctx: Ctx, a: MonitorAction) -> None:
             tried.add(t)
             cost = _cover(ctx, a, t, uids, ready.bound)
             if cost is not None and (best is None or cost < best[0]):
-                best = (cost, ctx.snapshot())
+                best = (cost, t, ctx.snapshot())
             ctx.restore(snap)
             if best is not None and group is fallback:
                 break
         if best is not None:
             break
+    if promised is not None and (best is None or best[1] > promised) and _keep_start(ctx, a, uids):
+        return  # the earlier start did not work out: the promise stands
     if best is None:
         ctx.add_unplaced(a.id, None, "monitor_coverage_infeasible")
         return
-    ctx.restore(best[1])
+    ctx.restore(best[2])

@@ -14,6 +14,8 @@ from proto import (
     AgentState,
     AgentStatus,
     CancelAction,
+    Command,
+    ControlUav,
     DeliverAction,
     EventKind,
     FlightState,
@@ -431,3 +433,33 @@ def test_a_replan_while_a_segment_is_flown_neither_starts_the_watch_over_nor_ext
     record = gs.store.action("watch")
     assert record.state == ActionState.COMPLETED
     assert record.monitored_s == pytest.approx(90.0)
+
+
+def test_monitors_serialised_on_the_one_uav_there_was_spread_out_when_others_are_back(gs):
+    """Two watches asked while uav-2 and uav-3 are held both go to uav-1, one
+    after the other; once the others are given back, the second watch
+    starts at once on another UAV instead of keeping its promised start a
+    watch later."""
+    for uav in ("uav-2", "uav-3"):
+        gs.manager.control(ControlUav(uav_id=uav, command=Command.HOLD))
+    gs.settle()
+    for name in ("first", "second"):
+        submit(gs, MonitorAction(worker_id="W2", uavs=1, standoff_m=4, duration_s=90), name)
+
+    def starts() -> dict[str, tuple[str, float]]:
+        return {
+            t.action_id: (u, t.end_s - t.duration_s)
+            for u in ALL
+            for t in gs.replanner.plans[u].tasks
+            if isinstance(t, MonitorTask)
+        }
+
+    serial = starts()
+    assert serial["first"][0] == serial["second"][0] == "uav-1"
+    assert serial["second"][1] >= serial["first"][1] + 90.0
+    for uav in ("uav-2", "uav-3"):
+        gs.manager.control(ControlUav(uav_id=uav, command=Command.RESUME))
+    gs.settle()
+    spread = starts()
+    assert spread["first"][0] != spread["second"][0]
+    assert spread["second"][1] < serial["second"][1] - 60.0
