@@ -89,7 +89,8 @@ def _next_event(s: Session, rng: random.Random, pool: list, n: int) -> Event | N
         if isinstance(a, DeliverAction) and a.tool_station not in tool_stations(problem):
             a = msgspec.structs.replace(a, tool_station=problem.tool_stations[0].id)
         if isinstance(a, MonitorAction):
-            a = msgspec.structs.replace(a, bearing_deg=ring_bearing(problem.actions, a.worker_m))
+            bearing = ring_bearing(problem.actions, a.worker_m, a.k)
+            a = msgspec.structs.replace(a, bearing_deg=bearing)
         return ActionAdded(action=msgspec.structs.replace(a, id=f"ev{n}"))
     if kind == "cancel":
         return ActionCancelled(action_id=rng.choice(problem.actions).id)

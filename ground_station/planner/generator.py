@@ -17,7 +17,6 @@ more than a battery) and ``tools`` (mostly deliveries, one gripper UAV).
 from __future__ import annotations
 
 import dataclasses
-import itertools
 import random
 from collections.abc import Iterable
 from math import sin
@@ -65,18 +64,37 @@ TYPES = (
 )
 
 
-RING_TURN_DEG = 37.0
+RING_STEP_DEG = 5.0
+"""Bearings tried for a worker's next monitoring, this far apart."""
 
 
-def ring_bearing(actions: Iterable[Action], worker_m: Vec3) -> float:
-    """A bearing for one more monitoring of the worker at ``worker_m``: the
-    first multiple of ``RING_TURN_DEG`` none of its monitors in ``actions``
-    uses, so that their slots never coincide (the ground station spreads
-    them alike)."""
-    taken = {
-        a.bearing_deg for a in actions if isinstance(a, MonitorAction) and a.worker_m == worker_m
-    }
-    return next(RING_TURN_DEG * i for i in itertools.count() if RING_TURN_DEG * i not in taken)
+def _slots_deg(bearing_deg: float, k: int) -> list[float]:
+    return [(bearing_deg + 360.0 * s / k) % 360.0 for s in range(k)]
+
+
+def _apart_deg(a: float, b: float) -> float:
+    d = abs(a - b) % 360.0
+    return min(d, 360.0 - d)
+
+
+def ring_bearing(actions: Iterable[Action], worker_m: Vec3, k: int = 1) -> float:
+    """A bearing for one more ``k``-UAV monitoring of the worker at
+    ``worker_m`` that keeps its slots farthest from those of the worker's
+    monitors in ``actions`` (the smallest angle maximised, as the ground
+    station spreads them), so that no two slots coincide."""
+    taken = [
+        b
+        for a in actions
+        if isinstance(a, MonitorAction) and a.worker_m == worker_m
+        for b in _slots_deg(a.bearing_deg, a.k)
+    ]
+    if not taken:
+        return 0.0
+    candidates = [i * RING_STEP_DEG for i in range(round(360.0 / k / RING_STEP_DEG))]
+    return max(
+        candidates,
+        key=lambda c: min(_apart_deg(m, t) for m in _slots_deg(c, k) for t in taken),
+    )
 
 
 @dataclasses.dataclass(frozen=True)
@@ -194,14 +212,15 @@ def generate(n_uavs: int, n_actions: int, seed: int = 0, family: str = "corridor
             )
         elif r < fam.mix[1]:
             tx, ty, tz = towers[centre]
+            k = _k(fam, rng, n_uavs)
             actions.append(
                 MonitorAction(
-                    bearing_deg=ring_bearing(actions, (tx, ty, tz - 5.0)),
+                    bearing_deg=ring_bearing(actions, (tx, ty, tz - 5.0), k),
                     id=f"A{i:03d}",
                     weight=weight,
                     release_s=release,
                     worker_m=(tx, ty, tz - 5.0),
-                    k=_k(fam, rng, n_uavs),
+                    k=k,
                     standoff_m=10.0,
                     duration_s=float(rng.choice(fam.durations_s)),
                 )
