@@ -91,13 +91,14 @@ def build_problem(
     """The planner's view of the mission at ``now_s`` (mission seconds).
     ``monitor_starts`` holds the synchronised starts (mission seconds)
     already promised for monitoring actions; future ones are kept if feasible.
-    ``flying`` are the monitoring segments being flown: what they have
-    flown is no longer asked of the plan (only ended segments are in a
-    record's ``monitored_s``), so a replan never starts a watch over."""
+    ``flying`` are the monitoring segments being flown: what those whose
+    window has begun have flown is no longer asked of the plan (only ended
+    segments are in a record's ``monitored_s``), so a replan never starts a
+    watch over, and the rest of it starts at once."""
     workers = {w.id: w.position for w in site.workers} | (worker_positions or {})
     behind: dict[str, float] = {}
     for segment in flying:
-        if segment.action_id is not None:
+        if segment.action_id is not None and segment.end_s - segment.duration_s <= now_s:
             share = flown_s(segment, now_s) / segment.slots
             behind[segment.action_id] = behind.get(segment.action_id, 0.0) + share
     specs = {u.id: u for u in fleet.uavs}
@@ -152,7 +153,7 @@ def build_problem(
             for u in uavs
         ),
         actions=tuple(
-            _action(r, workers, safety, now_s, monitor_starts or {}, behind.get(r.action_id, 0.0))
+            _action(r, workers, safety, now_s, monitor_starts or {}, behind.get(r.action_id))
             for r in records
         ),
     )
@@ -164,12 +165,14 @@ def _action(
     safety: Safety,
     now_s: float,
     monitor_starts: dict[str, float],
-    flying_s: float,
+    flying_s: float | None,
 ) -> pl.Action:
     """The planner's action; a delivery's ``worker_m`` is its drop point,
     ``DROP_HEIGHT_M`` above the worker, where the agent releases the tool; a
     monitor's duration is what is left of it (``flying_s``: flown in the
-    segments being flown)."""
+    segments being flown, None if none is), and one being flown goes on
+    now: what is left starts at once (the UAVs on station keep it, unless
+    they cannot), never after a gap for a UAV the planner likes better."""
     action = record.action
     common = {
         "id": record.action_id,
@@ -194,8 +197,10 @@ def _action(
                 standoff_m=action.standoff_m,
                 height_m=safety.monitor_height_m,
                 bearing_deg=action.bearing_deg or 0.0,
-                duration_s=max(1.0, action.duration_s - record.monitored_s - flying_s),
-                start_s=_promised(monitor_starts.get(record.action_id), now_s),
+                duration_s=max(1.0, action.duration_s - record.monitored_s - (flying_s or 0.0)),
+                start_s=0.0
+                if flying_s is not None
+                else _promised(monitor_starts.get(record.action_id), now_s),
             )
         case DeliverAction():
             return pl.DeliverAction(

@@ -463,3 +463,30 @@ def test_monitors_serialised_on_the_one_uav_there_was_spread_out_when_others_are
     spread = starts()
     assert spread["first"][0] != spread["second"][0]
     assert spread["second"][1] < serial["second"][1] - 60.0
+
+
+def test_a_watch_being_flown_stays_with_its_uav_when_a_better_suited_one_comes_back(gs):
+    """uav-1 watches W2 while the others are held; given back, uav-3 (made
+    for monitoring) is better suited, but the rest of the watch starts at
+    once: uav-1 keeps the slot instead of leaving it for the seconds uav-3
+    needs to take off and come (a 12 s gap seen in the live fleet)."""
+    for uav in ("uav-2", "uav-3"):
+        gs.manager.control(ControlUav(uav_id=uav, command=Command.HOLD))
+    gs.settle()
+    submit(gs, MonitorAction(worker_id="W2", uavs=1, standoff_m=4, duration_s=200), "watch")
+    [segment] = [t for t in gs.replanner.plans["uav-1"].tasks if isinstance(t, MonitorTask)]
+    gs.now = segment.end_s - segment.duration_s + 20.0
+    on_station(gs, "uav-1", segment, Point(x_m=-1.0, y_m=15.0, z_m=6.0))
+    for uav in ("uav-2", "uav-3"):
+        gs.manager.control(ControlUav(uav_id=uav, command=Command.RESUME))
+    gs.settle()
+    going_on = [t for t in gs.replanner.plans["uav-1"].tasks if isinstance(t, MonitorTask)]
+    assert [t.task_id for t in going_on][:1] == [segment.task_id]
+    assert going_on[0].end_s > gs.now + 30.0, "uav-1 stays on"
+    later = [
+        t.end_s - t.duration_s
+        for u in ("uav-2", "uav-3")
+        for t in gs.replanner.plans[u].tasks
+        if isinstance(t, MonitorTask)
+    ]
+    assert all(start >= going_on[0].end_s - 1.0 for start in later), "a relief, not a gap"
