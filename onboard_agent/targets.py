@@ -161,7 +161,7 @@ def return_point(ctx: Context) -> Point | None:
 def _landing(ctx: Context, station: ChargingStation) -> Point:
     """Above the spot of ``station`` granted to this UAV; above its hold
     point while the claim waits for the grant (see :mod:`onboard_agent.spots`)."""
-    spot = ctx.spots.landing_point(station, ctx.clock())
+    spot = ctx.spots.landing_point(station, ctx.clock(), on_ground=ctx.vehicle.landed)
     if spot is None:
         return ctx.spots.hold_point(station, ctx.config.approach_alt_m)
     return _above(spot, ctx.config.approach_alt_m)
@@ -177,11 +177,16 @@ def task_station(ctx: Context) -> ChargingStation | None:
 
 def landing_station(ctx: Context) -> ChargingStation | None:
     """Where to land off the plan (battery low, mission over, emergency): the
-    station granted already, else the nearest with room, else the nearest."""
+    station granted already, else the nearest with room, else the nearest.
+    None while the autopilot has no position: "nearest" to the placeholder
+    it reports until its first fix (the origin) would claim a spot at a
+    station the UAV is not near, a grant that then sticks (issue 21)."""
     stations = ctx.surroundings.site.stations
     granted = [s for s in stations if ctx.spots.granted(s.id) is not None]
     if granted:
         return granted[0]
+    if not ctx.vehicle.known:
+        return None
     here = ctx.vehicle.position
     roomy = [s for s in stations if ctx.spots.has_room(s.id)]
     return ctx.surroundings.nearest_station(here, roomy or stations)
@@ -198,7 +203,9 @@ def station_target(pick: Callable[[Context], ChargingStation | None]) -> Target:
 
     def cleared(ctx: Context) -> bool:
         station = pick(ctx)
-        return station is None or ctx.spots.cleared(station.id, ctx.clock())
+        if station is None:
+            return True
+        return ctx.spots.cleared(station.id, ctx.clock(), on_ground=ctx.vehicle.landed)
 
     def cruise_z(ctx: Context) -> float | None:
         station = pick(ctx)

@@ -101,3 +101,57 @@ def test_a_flight_to_a_station_crosses_at_the_uav_s_own_hold_height():
     )
     hold = rig.agent.ctx.spots.hold_point(C3, rig.agent.ctx.config.approach_alt_m).z_m
     assert hold in heights and max(heights) == hold
+
+
+def test_before_its_position_is_known_a_uav_claims_no_spot_at_another_station():
+    """Issue 21: an agent that starts on its home spot ticks before the
+    autopilot's first position (the origin until then, on a loaded machine
+    for longer). The nearest station from that made-up point (C1) must not
+    be claimed: its grant would stick and the UAV would fly off its own
+    pad to land beside another UAV at C1, both then taking off together."""
+    c2 = SCENARIO.site.station("C2")
+    home = spot_positions(c2, SCENARIO.fleet)[0]  # where the simulator starts uav-2
+    rig = Rig(uav_id="uav-2", position=point(0, 0, 0))
+    rig.autopilot.update(known=False)
+    spots = rig.agent.ctx.spots
+    spots.update(feed("C1", [None, None], landed=["uav-1", None]), rig.clock())
+    spots.update(feed("C2", [None, None], landed=["uav-2", None]), rig.clock())
+    spots.update(feed("C3", [None, None], landed=["uav-3", None]), rig.clock())
+    rig.agent.offer_plan(plan(uav_id="uav-2"))  # nothing to do: back to a station
+    claims = []
+    for _ in range(10):
+        rig.tick()
+        claims.append(spots.claim_due(rig.clock()))
+    assert [c for c in claims if c is not None] == []  # nearest to an unknown place: none
+    assert spots.granted("C1") is None and not rig.autopilot.state.armed
+    rig.autopilot.update(known=True, position=home)  # the first fix: on its home spot
+    rig.tick()
+    claim = spots.claim_due(rig.clock())
+    assert claim is not None and (claim.station_id, claim.spot) == ("C2", 0)
+    spots.update(feed("C2", ["uav-2", None], landed=["uav-2", None], stamp=2.0), rig.clock())
+    rig.tick(10)
+    assert "takeoff" not in [name for name, _ in rig.autopilot.calls]  # stays on its pad
+    assert rig.autopilot.state.landed and rig.autopilot.state.position == home
+
+
+def test_a_uav_on_a_spot_waits_there_for_its_grant_instead_of_taking_off():
+    """Sitting on a spot of the station it is to land at (its home spot at
+    the start; one whose grant it gave back while it waited on the ground),
+    a UAV claims that very spot and stays on it until the grant comes: no
+    hop up to the hold point and back down next to the other spots, however
+    late the controller answers (a loaded machine)."""
+    rig = Rig(uav_id="uav-3", position=C3_SPOTS[1])
+    spots = rig.agent.ctx.spots
+    spots.update(feed("C3", [None, None], landed=["uav-1", "uav-3"]), rig.clock())
+    rig.agent.offer_plan(plan(uav_id="uav-3"))  # nothing to do: back to a station
+    claims = []
+    for _ in range(30):  # three mission seconds without an answer
+        rig.tick()
+        claims.append(spots.claim_due(rig.clock()))
+    sent = {(c.station_id, c.spot) for c in claims if c is not None}
+    assert sent == {("C3", 1)}  # the spot it sits on, not spot 0 nor another station
+    assert not any(name in ("arm", "takeoff") for name, _ in rig.autopilot.calls)
+    assert rig.autopilot.state.landed and rig.autopilot.state.position == C3_SPOTS[1]
+    spots.update(feed("C3", [None, "uav-3"], landed=["uav-1", "uav-3"], stamp=2.0), rig.clock())
+    rig.tick(5)
+    assert not any(name in ("arm", "takeoff") for name, _ in rig.autopilot.calls)
