@@ -6,9 +6,7 @@ the fleet), so that UAVs waiting for one station never meet; flights to a
 station cross at that height too. A station whose controller has not been
 heard is landed on at its position, as before there were spots; one not
 heard for ``STALE_S`` (the UAV is cut off) on the spot its last feed showed
-free, so that a partition never keeps a UAV in the air. A UAV already
-sitting on a spot of the station claims that spot and waits for the grant
-on it, on the ground."""
+free, so that a partition never keeps a UAV in the air."""
 
 from __future__ import annotations
 
@@ -77,22 +75,14 @@ class Spots:
         """Whether this UAV can land at ``station_id`` now or after a claim."""
         return station_id not in self._feeds or self._free(station_id) is not None
 
-    def cleared(self, station_id: str, now_s: float, on_ground: bool = False) -> bool:
+    def cleared(self, station_id: str, now_s: float) -> bool:
         """Whether this UAV may land at ``station_id`` now: granted, or its
-        controller unheard or silent for ``STALE_S``, or (``on_ground``)
-        sitting on a spot there that no other UAV may land on."""
-        if not self._live(station_id, now_s) or self.granted(station_id) is not None:
-            return True
-        return on_ground and self._sits_on_free(station_id)
+        controller unheard or silent for ``STALE_S``."""
+        return not self._live(station_id, now_s) or self.granted(station_id) is not None
 
-    def landing_point(
-        self, station: ChargingStation, now_s: float, on_ground: bool = False
-    ) -> Point | None:
+    def landing_point(self, station: ChargingStation, now_s: float) -> Point | None:
         """Where to land at ``station``: the granted spot (or the station, if
-        its controller is unheard); None while a claim waits for its grant,
-        unless the UAV is ``on_ground`` on the spot it claims: it waits for
-        the grant there rather than taking off to hold (the controller never
-        grants a spot somebody sits on to another UAV)."""
+        its controller is unheard); None while a claim waits for its grant."""
         self._used_s[station.id] = now_s
         if station.id not in self._feeds:
             return station.position
@@ -106,9 +96,6 @@ class Spots:
             self._wanted = None
             return spot_positions(station, self.fleet)[spot]
         self._wanted = (station.id, free) if free is not None else None
-        sat = self._sitting(station.id) if on_ground else None
-        if sat is not None and sat == free:
-            return spot_positions(station, self.fleet)[sat]  # waits for the grant on it
         return None
 
     def hold_point(self, station: ChargingStation, approach_alt_m: float) -> Point:
@@ -137,28 +124,11 @@ class Spots:
         self._claimed, self._claimed_s = want, now_s
         return SpotClaim(uav_id=self.uav_id, station_id=want[0], spot=want[1], stamp_s=now_s)
 
-    def _sitting(self, station_id: str) -> int | None:
-        """The spot of ``station_id`` its last feed shows this UAV sitting on."""
-        feed = self._feeds.get(station_id)
-        if feed is None:
-            return None
-        return next((i for i, sitter in enumerate(feed.landed) if sitter == self.uav_id), None)
-
-    def _sits_on_free(self, station_id: str) -> bool:
-        """Whether the spot this UAV sits on at ``station_id`` is the one it claims."""
-        sat = self._sitting(station_id)
-        return sat is not None and self._free(station_id) == sat
-
     def _free(self, station_id: str) -> int | None:
-        """This UAV's spot at ``station_id``: granted, else the one it sits
-        on (unless granted to another), else the first neither granted nor taken."""
         feed = self._feeds[station_id]
         mine = self.granted(station_id)
         if mine is not None:
             return mine
-        sat = self._sitting(station_id)
-        if sat is not None and (sat >= len(feed.granted) or feed.granted[sat] is None):
-            return sat
         for i, (granted, landed) in enumerate(zip(feed.granted, feed.landed, strict=False)):
             if granted is None and landed in (None, self.uav_id):
                 return i

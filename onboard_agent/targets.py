@@ -161,7 +161,7 @@ def return_point(ctx: Context) -> Point | None:
 def _landing(ctx: Context, station: ChargingStation) -> Point:
     """Above the spot of ``station`` granted to this UAV; above its hold
     point while the claim waits for the grant (see :mod:`onboard_agent.spots`)."""
-    spot = ctx.spots.landing_point(station, ctx.clock(), on_ground=ctx.vehicle.landed)
+    spot = ctx.spots.landing_point(station, ctx.clock())
     if spot is None:
         return ctx.spots.hold_point(station, ctx.config.approach_alt_m)
     return _above(spot, ctx.config.approach_alt_m)
@@ -203,9 +203,7 @@ def station_target(pick: Callable[[Context], ChargingStation | None]) -> Target:
 
     def cleared(ctx: Context) -> bool:
         station = pick(ctx)
-        if station is None:
-            return True
-        return ctx.spots.cleared(station.id, ctx.clock(), on_ground=ctx.vehicle.landed)
+        return station is None or ctx.spots.cleared(station.id, ctx.clock())
 
     def cruise_z(ctx: Context) -> float | None:
         station = pick(ctx)

@@ -132,26 +132,3 @@ def test_before_its_position_is_known_a_uav_claims_no_spot_at_another_station():
     rig.tick(10)
     assert "takeoff" not in [name for name, _ in rig.autopilot.calls]  # stays on its pad
     assert rig.autopilot.state.landed and rig.autopilot.state.position == home
-
-
-def test_a_uav_on_a_spot_waits_there_for_its_grant_instead_of_taking_off():
-    """Sitting on a spot of the station it is to land at (its home spot at
-    the start; one whose grant it gave back while it waited on the ground),
-    a UAV claims that very spot and stays on it until the grant comes: no
-    hop up to the hold point and back down next to the other spots, however
-    late the controller answers (a loaded machine)."""
-    rig = Rig(uav_id="uav-3", position=C3_SPOTS[1])
-    spots = rig.agent.ctx.spots
-    spots.update(feed("C3", [None, None], landed=["uav-1", "uav-3"]), rig.clock())
-    rig.agent.offer_plan(plan(uav_id="uav-3"))  # nothing to do: back to a station
-    claims = []
-    for _ in range(30):  # three mission seconds without an answer
-        rig.tick()
-        claims.append(spots.claim_due(rig.clock()))
-    sent = {(c.station_id, c.spot) for c in claims if c is not None}
-    assert sent == {("C3", 1)}  # the spot it sits on, not spot 0 nor another station
-    assert not any(name in ("arm", "takeoff") for name, _ in rig.autopilot.calls)
-    assert rig.autopilot.state.landed and rig.autopilot.state.position == C3_SPOTS[1]
-    spots.update(feed("C3", [None, "uav-3"], landed=["uav-1", "uav-3"], stamp=2.0), rig.clock())
-    rig.tick(5)
-    assert not any(name in ("arm", "takeoff") for name, _ in rig.autopilot.calls)
