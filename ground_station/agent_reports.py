@@ -158,6 +158,9 @@ class AgentReports:
                 self._credit(record, task, outcome, f"{outcome.task_id} {outcome.result}")
         if isinstance(task, MonitorTask) and outcome.result == OutcomeResult.COMPLETED:
             self._announce_handover(outcome.uav_id, task)
+        if isinstance(task, PickTask | DeliverTask) and outcome.result == OutcomeResult.COMPLETED:
+            held = (outcome.tool or task.tool) if isinstance(task, PickTask) else None
+            self.monitor.on_handled_tool(outcome.uav_id, held, outcome.stamp_s)
         self.replanner.finished(outcome.uav_id, outcome.task_id)
         if outcome.result == OutcomeResult.FAILED and self._gave_up_safely(task, outcome, judged):
             return

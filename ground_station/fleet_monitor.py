@@ -80,6 +80,7 @@ class _Uav:
     telemetry: Telemetry | None = None
     status: AgentStatus | None = None
     down: Change | None = None  # CRASHED / FAILED already reported for the current spell
+    handled: tuple[str | None, float] | None = None  # (tool, agent stamp) of its last pick / drop
 
 
 def _down(uav: _Uav) -> Change | None:
@@ -194,6 +195,23 @@ class FleetMonitor:
     def telemetry(self, uav_id: str) -> Telemetry | None:
         """The latest telemetry of ``uav_id``."""
         return self._uavs[uav_id].telemetry
+
+    def on_handled_tool(self, uav_id: str, tool: str | None, stamp_s: float) -> None:
+        """``uav_id`` reported a completed pick of ``tool`` (or a drop: None)
+        at ``stamp_s`` of its clock, which telemetry may not show yet."""
+        uav = self._uavs.get(uav_id)
+        if uav is not None:
+            uav.handled = (tool, stamp_s)
+
+    def tool(self, uav_id: str) -> str | None:
+        """The tool ``uav_id`` holds: its latest telemetry's, unless a pick or
+        drop it reported later says otherwise (a plan made between the two
+        would pick the tool again)."""
+        uav = self._uavs[uav_id]
+        seen = uav.telemetry
+        if uav.handled is not None and (seen is None or uav.handled[1] > seen.stamp_s):
+            return uav.handled[0]
+        return seen.tool if seen is not None else None
 
     def status(self, uav_id: str) -> AgentStatus | None:
         """The latest status of ``uav_id``."""

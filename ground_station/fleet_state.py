@@ -46,7 +46,7 @@ def uavs_now(
                 energy_wh=min(capacity, telemetry.battery_wh) if telemetry else capacity,
                 available=monitor.available(spec.id) and spec.id not in controlled,
                 airborne=bool(telemetry and telemetry.flight_state in AIRBORNE),
-                tool=telemetry.tool if telemetry else None,
+                tool=monitor.tool(spec.id),
                 running_action=running_action(monitor, plans.get(spec.id), in_force),
             )
         )
@@ -55,16 +55,16 @@ def uavs_now(
 
 def running_action(monitor: FleetMonitor, plan: Plan | None, in_force: set[str]) -> str | None:
     """The monitoring action in force the UAV of ``plan`` is executing, or the
-    delivery whose tool its telemetry says it holds, if any."""
+    delivery whose tool it holds, if any."""
     if plan is None:
         return None
-    status, telemetry = monitor.status(plan.uav_id), monitor.telemetry(plan.uav_id)
+    status = monitor.status(plan.uav_id)
     if status is None or status.task_id is None:
         return None
     for task in plan.tasks:
         if task.task_id != status.task_id or task.action_id not in in_force:
             continue
-        holds_tool = telemetry is not None and telemetry.tool == getattr(task, "tool", None)
+        holds_tool = monitor.tool(plan.uav_id) == getattr(task, "tool", None)
         if isinstance(task, MonitorTask) or (isinstance(task, DeliverTask) and holds_tool):
             return task.action_id
     return None

@@ -22,7 +22,8 @@ HOLD_STEP_M = 2.0
 CLAIM_EVERY_S = 1.0
 """A claim not granted yet is repeated this often (mission seconds)."""
 UNUSED_S = 5.0
-"""A grant the UAV has not flown to for this long is given back."""
+"""A grant the UAV has not flown to for this long is given back, and a
+wanted spot not asked for again for this long is no longer claimed."""
 STALE_S = 10.0
 """A station feed older than this (mission seconds) no longer gates landing."""
 
@@ -109,12 +110,12 @@ class Spots:
         """The claim to send now, if any: a wanted spot (again every
         ``CLAIM_EVERY_S`` until granted), or giving back a grant unused for
         ``UNUSED_S``."""
+        if self._wanted is not None and self._unused(self._wanted[0], now_s):
+            self._wanted = None  # e.g. the plan moved on before the grant came
         want: tuple[str | None, int] | None = self._wanted
         if want is None:
             stale = [
-                s
-                for s in self._feeds
-                if self.granted(s) is not None and now_s - self._used_s.get(s, now_s) > UNUSED_S
+                s for s in self._feeds if self.granted(s) is not None and self._unused(s, now_s)
             ]
             want = (None, 0) if stale else None
         if want is None:
@@ -123,6 +124,11 @@ class Spots:
             return None
         self._claimed, self._claimed_s = want, now_s
         return SpotClaim(uav_id=self.uav_id, station_id=want[0], spot=want[1], stamp_s=now_s)
+
+    def _unused(self, station_id: str, now_s: float) -> bool:
+        """Whether this UAV has not asked where to land at ``station_id``
+        for ``UNUSED_S`` (or ever: a grant it never asked for)."""
+        return now_s - self._used_s.get(station_id, -math.inf) > UNUSED_S
 
     def _free(self, station_id: str) -> int | None:
         feed = self._feeds[station_id]

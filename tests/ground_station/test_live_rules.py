@@ -17,12 +17,14 @@ from proto import (
     Command,
     ControlUav,
     DeliverAction,
+    DeliverTask,
     EventKind,
     FlightState,
     GoHomeTask,
     MonitorAction,
     MonitorTask,
     OutcomeResult,
+    PickTask,
     Point,
     SubmitAction,
     TaskOutcome,
@@ -141,6 +143,21 @@ def test_a_drop_with_the_tool_carried_to_the_worker_completes(gs):
     drop = next(t for t in gs.replanner.plans["uav-1"].tasks if t.task_id == drop.task_id)
     outcome(gs, "uav-1", drop)
     assert gs.store.action("d").state == ActionState.COMPLETED
+
+
+def test_a_tool_picked_before_telemetry_shows_it_is_not_picked_again(gs):
+    """The pick's outcome comes before the telemetry that shows the tool
+    held: the replan it triggers keeps the drop and sends no new pick (a
+    new pick, done at once on board, triggered the next replan, and so on)."""
+    submit(gs, DeliverAction(tool="wrench", tool_station_id="tp-wrench", worker_id="W1"), "d")
+    pick = gs.replanner.plans["uav-1"].tasks[0]
+    sent = len(gs.sent)
+    gs.now += 1.0  # telemetry so far: landed, no tool
+    outcome(gs, "uav-1", pick, stamp_s=gs.now)
+    tasks = gs.replanner.plans["uav-1"].tasks
+    assert not any(isinstance(t, PickTask) for t in tasks), tasks
+    assert any(isinstance(t, DeliverTask) for t in tasks), tasks
+    assert len(gs.sent) == sent  # nothing new to fly: no new epoch
 
 
 def test_a_crashed_uav_is_declared_at_once_and_its_work_goes_elsewhere(gs):

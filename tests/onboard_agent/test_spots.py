@@ -74,6 +74,22 @@ def test_a_grant_not_flown_to_is_given_back():
     assert release is not None and release.station_id is None
 
 
+def test_a_spot_wanted_then_left_behind_is_not_claimed_on_and_on():
+    """A UAV asked for a spot, then its plan took it elsewhere before the
+    grant: it stops claiming, and a grant that comes late is given back
+    (a stuck grant drew its emergency landing to the wrong station)."""
+    rig = Rig()
+    spots = rig.agent.ctx.spots
+    spots.update(feed("C3", [None, None]), rig.clock())
+    assert spots.landing_point(C3, rig.clock()) is None  # waits for a grant
+    assert spots.claim_due(rig.clock()).station_id == "C3"
+    rig.clock.advance(6.0)  # no longer asked where to land at C3
+    assert spots.claim_due(rig.clock()) is None
+    spots.update(feed("C3", ["uav-1", None], stamp=2.0), rig.clock())  # the late grant
+    release = spots.claim_due(rig.clock())
+    assert release is not None and release.station_id is None
+
+
 def test_cut_off_from_the_controller_it_lands_on_the_spot_last_seen_free():
     """A partition must never keep a UAV in the air: once the feed is older
     than STALE_S, the spot the last feed showed free is landed on."""
