@@ -298,6 +298,41 @@ def to_tasks(
     return _lead_departures(tasks)
 
 
+def name_reliefs(tasks: dict[str, list[Task]]) -> dict[str, list[Task]]:
+    """Each UAV's tasks with every monitoring segment naming the UAV whose
+    segment of the same slot begins where it ends (within
+    ``SAME_SEGMENT_S``), if any: the agent keeps watching until that relief
+    is there, so a late relief leaves no gap."""
+    starts = [
+        (t.action_id, t.slot, t.end_s - t.duration_s, uav_id)
+        for uav_id, listed in tasks.items()
+        for t in listed
+        if isinstance(t, MonitorTask)
+    ]
+
+    def relief(task: MonitorTask, uav_id: str) -> str | None:
+        return next(
+            (
+                other
+                for action_id, slot, start_s, other in starts
+                if other != uav_id
+                and (action_id, slot) == (task.action_id, task.slot)
+                and abs(start_s - task.end_s) <= SAME_SEGMENT_S
+            ),
+            None,
+        )
+
+    return {
+        uav_id: [
+            msgspec.structs.replace(t, relieved_by=relief(t, uav_id))
+            if isinstance(t, MonitorTask)
+            else t
+            for t in listed
+        ]
+        for uav_id, listed in tasks.items()
+    }
+
+
 def _lead_departures(tasks: list[Task]) -> list[Task]:
     """End each wait before a monitoring segment ``TAKEOFF_LEAD_S`` early
     (never before the wait's start): the planner counts no time for
@@ -415,5 +450,6 @@ def _same_task(a: Task, b: Task) -> bool:
             abs(a.end_s - b.end_s) <= SAME_SEGMENT_S
             and abs(starts[0] - starts[1]) <= SAME_SEGMENT_S
             and a.bearing_deg == b.bearing_deg  # a slot moved: its UAV must hear it
+            and a.relieved_by == b.relieved_by  # whom to wait for before leaving
         )
     return True

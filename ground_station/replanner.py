@@ -29,7 +29,13 @@ from ground_station.live_plan import (
     frozen_tasks,
 )
 from ground_station.operator_control import OperatorControl
-from ground_station.planning import build_problem, monitor_starts, same_work, to_tasks
+from ground_station.planning import (
+    build_problem,
+    monitor_starts,
+    name_reliefs,
+    same_work,
+    to_tasks,
+)
 from ground_station.replan_jobs import Computed, ImproveSettings, Job, ReplanOutcome, ReplanStats
 from ground_station.store import Store, StoreUnavailable
 from proto.events import EventKind
@@ -199,9 +205,9 @@ class Replanner:
     def _wire(self, result: pl.Plan, job: Job, base_s: float) -> dict:
         site, fleet = self.scenario.site, self.scenario.fleet
         by_id = {r.action_id: r for r in job.records}
-        return {
-            up.uav_id: to_tasks(up, site, fleet, by_id, base_s, job.flying) for up in result.uavs
-        }
+        return name_reliefs(
+            {up.uav_id: to_tasks(up, site, fleet, by_id, base_s, job.flying) for up in result.uavs}
+        )
 
     def commit(self, computed: Computed) -> ReplanOutcome | None:
         """Adopt a computed plan (on the loop): a new epoch for the UAVs whose

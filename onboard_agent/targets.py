@@ -11,6 +11,8 @@ import dataclasses
 import math
 from collections.abc import Callable
 
+import msgspec
+
 from onboard_agent.context import Context
 from onboard_agent.surroundings import horizontal_distance
 from proto.geo import Point
@@ -91,13 +93,40 @@ def monitor_slot(ctx: Context) -> Point | None:
     them (never at a person's own height). Before the segment's window
     begins (a relief that arrived early, while the UAV it relieves still
     holds the slot) the point lies ``handover_hold_m`` farther out on the
-    same bearing, clear of that UAV."""
+    same bearing, clear of that UAV. Past its end, while the relief is not
+    there (:func:`awaiting_relief`), it lies on the ring ``wait_aside_m``
+    from the slot (counter-clockwise): the worker stays watched and the slot
+    is free for the relief to close in on."""
     task = ctx.mission.head
     if not isinstance(task, MonitorTask):
         return None
+    if awaiting_relief(ctx):
+        chord = min(1.0, ctx.config.wait_aside_m / (2.0 * task.standoff_m))
+        turn_deg = 2.0 * math.degrees(math.asin(chord))
+        turned = msgspec.structs.replace(task, bearing_deg=task.bearing_deg + turn_deg)
+        return _ring_point(ctx, turned, task.standoff_m)
+    return _slot_point(ctx, task)
+
+
+def _slot_point(ctx: Context, task: MonitorTask) -> Point | None:
     early = task.end_s > 0 and ctx.wall() < task.end_s - task.duration_s
     radius = task.standoff_m + (ctx.config.handover_hold_m if early else 0.0)
     return _ring_point(ctx, task, radius)
+
+
+def awaiting_relief(ctx: Context) -> bool:
+    """Whether the head segment is past its end and the relief it names is
+    not at the slot yet (not within ``handover_hold_m`` + ``near_slot_m``
+    of it in the traffic report), for at most ``relief_wait_s``."""
+    task, config = ctx.mission.head, ctx.config
+    if not isinstance(task, MonitorTask) or task.relieved_by is None or task.end_s <= 0:
+        return False
+    if not task.end_s <= ctx.wall() < task.end_s + config.relief_wait_s:
+        return False
+    slot = _slot_point(ctx, task)
+    there = ctx.traffic.position(task.relieved_by, ctx.link_clock())
+    near_m = config.handover_hold_m + config.near_slot_m
+    return slot is not None and (there is None or there.distance_to(slot) > near_m)
 
 
 def _not_handing_over(ctx: Context) -> bool:

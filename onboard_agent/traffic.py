@@ -30,6 +30,20 @@ class Traffic:
         """Keep ``report`` (received at ``now_s`` of the link clock)."""
         self._report, self._received_s = report, now_s
 
+    def position(self, uav_id: str, now_s: float) -> Point | None:
+        """Where ``uav_id`` was last heard airborne, if the report says so."""
+        if self._report is None:
+            return None
+        since = now_s - self._received_s
+        return next(
+            (
+                e.position
+                for e in self._report.uavs
+                if e.uav_id == uav_id and e.airborne and e.age_s + since <= STALE_S
+            ),
+            None,
+        )
+
     def holder(self, point: Point, radius_m: float, now_s: float) -> str | None:
         """Another airborne UAV within ``radius_m`` of ``point``, if any (the nearest)."""
         if self._report is None:

@@ -51,7 +51,10 @@ class MonitorTask(TaskBase, frozen=True, kw_only=True, tag="monitor"):
     """Hold slot ``slot`` of ``slots`` around the worker (``standoff_m``
     away horizontally, ``height_m`` above them, at bearing ``bearing_deg``
     + 360 * slot / slots degrees from +x), following them, for
-    ``duration_s``."""
+    ``duration_s``. ``relieved_by`` names the UAV planned to take the slot
+    over at ``end_s``: until it is there (at most the agent's
+    ``relief_wait_s``, and only while the battery allows) this UAV keeps
+    watching from beside the slot instead of leaving the worker alone."""
 
     worker_id: Id
     slot: Count
@@ -60,6 +63,7 @@ class MonitorTask(TaskBase, frozen=True, kw_only=True, tag="monitor"):
     duration_s: Positive
     height_m: NonNegative = 3.0
     bearing_deg: Finite = 0.0
+    relieved_by: Id | None = None
 
 
 class PickTask(TaskBase, frozen=True, kw_only=True, tag="pick"):

@@ -14,8 +14,10 @@ class Monitor(AgentBehaviour):
     moves) and counts the time spent there. A planned segment is a time
     window: SUCCESS at its ``end_s`` (mission seconds), so the k UAVs of a
     slot set leave together and a relieved UAV stays until its relief's
-    start; a task without times ends after ``duration_s`` on station. The
-    time counted survives interruptions (it lives in the mission)."""
+    start (then beside the slot until the relief is there: see
+    :func:`targets.awaiting_relief`); a task without times ends after
+    ``duration_s`` on station. The time counted survives interruptions (it
+    lives in the mission)."""
 
     def __init__(self, ctx: Context, name: str = "Monitoring") -> None:
         super().__init__(name, ctx)
@@ -41,7 +43,7 @@ class Monitor(AgentBehaviour):
         self._last_tick = now
         done_s = ctx.mission.monitored_s(task.task_id)
         over = ctx.wall() >= task.end_s if task.end_s > 0 else done_s >= task.duration_s
-        if over:
+        if over and not targets.awaiting_relief(ctx):
             self.feedback_message = f"monitored {task.worker_id} for {done_s:.0f} s"
             return Status.SUCCESS
         config = ctx.config
@@ -49,7 +51,12 @@ class Monitor(AgentBehaviour):
         if moved or now - self._sent_at >= config.goto_resend_s:
             ctx.autopilot.goto(slot)
             self._sent, self._sent_at = slot, now
-        self.feedback_message = f"monitoring {task.worker_id}, {done_s:.0f}/{task.duration_s:.0f} s"
+        if over:
+            self.feedback_message = f"watching {task.worker_id} until {task.relieved_by} is there"
+        else:
+            self.feedback_message = (
+                f"monitoring {task.worker_id}, {done_s:.0f}/{task.duration_s:.0f} s"
+            )
         return Status.RUNNING
 
 

@@ -4,6 +4,8 @@ stock, deliveries confirmed by telemetry, crashes handled at once."""
 
 from __future__ import annotations
 
+import itertools
+
 import msgspec
 import pytest
 
@@ -158,6 +160,22 @@ def test_a_tool_picked_before_telemetry_shows_it_is_not_picked_again(gs):
     assert not any(isinstance(t, PickTask) for t in tasks), tasks
     assert any(isinstance(t, DeliverTask) for t in tasks), tasks
     assert len(gs.sent) == sent  # nothing new to fly: no new epoch
+
+
+def test_a_segment_handed_over_names_its_relief_and_the_last_names_none(gs):
+    """1,500 s of W2 take three segments on alternating UAVs: each but the
+    last names the UAV that takes the slot over where it ends, which the
+    agent waits for before it leaves."""
+    submit(gs, MonitorAction(worker_id="W2", uavs=1, standoff_m=4, duration_s=1500), "long")
+    segments = sorted(
+        ((t, u) for u in ALL for t in gs.replanner.plans[u].tasks if isinstance(t, MonitorTask)),
+        key=lambda s: s[0].end_s,
+    )
+    assert len(segments) >= 3
+    for (task, uav), (after, relief) in itertools.pairwise(segments):
+        assert task.relieved_by == relief != uav
+        assert abs(after.end_s - after.duration_s - task.end_s) <= 5.0
+    assert segments[-1][0].relieved_by is None
 
 
 def test_a_crashed_uav_is_declared_at_once_and_its_work_goes_elsewhere(gs):

@@ -193,3 +193,53 @@ def test_a_relief_closes_in_at_its_window_though_the_uav_it_relieves_still_shows
     _traffic_at(rig, slot)  # the relieved UAV, as the (lagging) report last heard it
     rig.run_until(lambda: rig.wall() >= start + 0.5)
     assert last_goto(rig).distance_to(slot) < 0.1  # its turn: it closes in all the same
+
+
+def _relieved_segment(rig, duration_s: float = 6.0) -> MonitorTask:
+    return msgspec.structs.replace(
+        monitor(slot=0, slots=1, duration_s=duration_s),
+        start_s=rig.wall(),
+        end_s=rig.wall() + duration_s,
+        relieved_by="uav-2",
+    )
+
+
+def test_a_relieved_uav_watches_from_beside_its_slot_until_its_relief_is_there():
+    rig = Rig()
+    task = _relieved_segment(rig)
+    rig.agent.offer_plan(plan(task))
+    slot = point(W2.x_m + 4.0, W2.y_m, W2.z_m + task.height_m)
+    config = rig.agent.ctx.config
+    rig.run_until(lambda: rig.wall() >= task.end_s + 5.0)
+    assert rig.mission.head == task  # its relief is late: it stays
+    beside = last_goto(rig)
+    assert math.hypot(beside.x_m - W2.x_m, beside.y_m - W2.y_m) == pytest.approx(4.0)  # on the ring
+    assert beside.z_m == pytest.approx(slot.z_m)
+    assert beside.distance_to(slot) == pytest.approx(config.wait_aside_m)  # the slot left free
+    assert beside.distance_to(slot) > config.keep_clear_m  # so the relief does not hold off
+    _traffic_at(rig, point(slot.x_m + config.handover_hold_m, slot.y_m, slot.z_m))  # closing in
+    rig.run_until(lambda: rig.mission.head is None)
+    [outcome] = rig.outcomes()
+    assert outcome.result is OutcomeResult.COMPLETED
+
+
+def test_a_relief_that_never_comes_is_waited_for_at_most_relief_wait_s():
+    rig = Rig()
+    task = _relieved_segment(rig)
+    rig.agent.offer_plan(plan(task))
+    _traffic_at(rig, point(W2.x_m - 20.0, W2.y_m, W2.z_m + 3.0))  # uav-2, far away
+    rig.run_until(lambda: rig.mission.head is None)
+    waited = rig.wall() - task.end_s
+    assert (
+        rig.agent.ctx.config.relief_wait_s - 1.0
+        <= waited
+        <= rig.agent.ctx.config.relief_wait_s + 2.0
+    )
+
+
+def test_a_segment_naming_no_relief_ends_at_its_end():
+    rig = Rig()
+    task = msgspec.structs.replace(_relieved_segment(rig), relieved_by=None)
+    rig.agent.offer_plan(plan(task))
+    rig.run_until(lambda: rig.mission.head is None)
+    assert rig.wall() - task.end_s <= 1.0
