@@ -53,20 +53,29 @@ def uavs_now(
     return uavs
 
 
-def running_action(monitor: FleetMonitor, plan: Plan | None, in_force: set[str]) -> str | None:
-    """The monitoring action in force the UAV of ``plan`` is executing, or the
-    delivery whose tool it holds, if any."""
+def reported_task(monitor: FleetMonitor, plan: Plan | None, in_force: set[str]) -> Task | None:
+    """The task of ``plan`` its UAV's latest status says it is executing, if
+    that task belongs to an action in force."""
     if plan is None:
         return None
     status = monitor.status(plan.uav_id)
     if status is None or status.task_id is None:
         return None
     for task in plan.tasks:
-        if task.task_id != status.task_id or task.action_id not in in_force:
-            continue
-        holds_tool = monitor.tool(plan.uav_id) == getattr(task, "tool", None)
-        if isinstance(task, MonitorTask) or (isinstance(task, DeliverTask) and holds_tool):
-            return task.action_id
+        if task.task_id == status.task_id and task.action_id in in_force:
+            return task
+    return None
+
+
+def running_action(monitor: FleetMonitor, plan: Plan | None, in_force: set[str]) -> str | None:
+    """The monitoring action in force the UAV of ``plan`` is executing, or the
+    delivery whose tool it holds, if any."""
+    task = reported_task(monitor, plan, in_force)
+    if task is None or plan is None:
+        return None
+    holds_tool = monitor.tool(plan.uav_id) == getattr(task, "tool", None)
+    if isinstance(task, MonitorTask) or (isinstance(task, DeliverTask) and holds_tool):
+        return task.action_id
     return None
 
 
@@ -76,17 +85,10 @@ def flying_segments(
     """The monitoring segments of actions in force that their UAVs report
     flying now, by task id."""
     flying: dict[str, MonitorTask] = {}
-    for uav_id, plan in plans.items():
-        status = monitor.status(uav_id)
-        if status is None or status.task_id is None:
-            continue
-        for task in plan.tasks:
-            if (
-                task.task_id == status.task_id
-                and isinstance(task, MonitorTask)
-                and task.action_id in in_force
-            ):
-                flying[task.task_id] = task
+    for plan in plans.values():
+        task = reported_task(monitor, plan, in_force)
+        if isinstance(task, MonitorTask):
+            flying[task.task_id] = task
     return flying
 
 

@@ -74,8 +74,7 @@ def flown_s(segment: MonitorTask, at_s: float) -> float:
     """Seconds of its planned window a monitoring segment being flown has
     behind it at ``at_s`` (the agent counts its time on station within the
     window, so this is what it reports if it arrived in time)."""
-    begin = segment.end_s - segment.duration_s
-    return min(max(0.0, at_s - begin), segment.duration_s)
+    return min(max(0.0, at_s - segment.window_start_s), segment.duration_s)
 
 
 def build_problem(
@@ -98,7 +97,7 @@ def build_problem(
     workers = {w.id: w.position for w in site.workers} | (worker_positions or {})
     behind: dict[str, float] = {}
     for segment in flying:
-        if segment.action_id is not None and segment.end_s - segment.duration_s <= now_s:
+        if segment.action_id is not None and segment.window_start_s <= now_s:
             share = flown_s(segment, now_s) / segment.slots
             behind[segment.action_id] = behind.get(segment.action_id, 0.0) + share
     specs = {u.id: u for u in fleet.uavs}
@@ -226,7 +225,7 @@ def monitor_starts(plans: Iterable[Plan]) -> dict[str, float]:
     for plan in plans:
         for task in plan.tasks:
             if isinstance(task, MonitorTask) and task.action_id is not None:
-                begin = task.end_s - task.duration_s
+                begin = task.window_start_s
                 starts[task.action_id] = min(begin, starts.get(task.action_id, begin))
     return starts
 
@@ -304,7 +303,7 @@ def name_reliefs(tasks: dict[str, list[Task]]) -> dict[str, list[Task]]:
     ``SAME_SEGMENT_S``), if any: the agent keeps watching until that relief
     is there, so a late relief leaves no gap."""
     starts = [
-        (t.action_id, t.slot, t.end_s - t.duration_s, uav_id)
+        (t.action_id, t.slot, t.window_start_s, uav_id)
         for uav_id, listed in tasks.items()
         for t in listed
         if isinstance(t, MonitorTask)
@@ -445,7 +444,7 @@ def _same_task(a: Task, b: Task) -> bool:
     if isinstance(a, WaitTask) and isinstance(b, WaitTask):
         return abs(a.until_s - b.until_s) <= SAME_WAIT_S
     if isinstance(a, MonitorTask) and isinstance(b, MonitorTask):
-        starts = (a.end_s - a.duration_s, b.end_s - b.duration_s)
+        starts = (a.window_start_s, b.window_start_s)
         return (
             abs(a.end_s - b.end_s) <= SAME_SEGMENT_S
             and abs(starts[0] - starts[1]) <= SAME_SEGMENT_S

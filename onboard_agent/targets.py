@@ -109,7 +109,7 @@ def monitor_slot(ctx: Context) -> Point | None:
 
 
 def _slot_point(ctx: Context, task: MonitorTask) -> Point | None:
-    early = task.end_s > 0 and ctx.wall() < task.end_s - task.duration_s
+    early = task.end_s > 0 and ctx.wall() < task.window_start_s
     radius = task.standoff_m + (ctx.config.handover_hold_m if early else 0.0)
     return _ring_point(ctx, task, radius)
 
@@ -136,7 +136,7 @@ def _not_handing_over(ctx: Context) -> bool:
     task = ctx.mission.head
     if not isinstance(task, MonitorTask) or task.end_s <= 0:
         return True
-    start = task.end_s - task.duration_s
+    start = task.window_start_s
     return not start <= ctx.wall() < start + ctx.config.handover_grace_s
 
 

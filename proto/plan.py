@@ -65,6 +65,12 @@ class MonitorTask(TaskBase, frozen=True, kw_only=True, tag="monitor"):
     bearing_deg: Finite = 0.0
     relieved_by: Id | None = None
 
+    @property
+    def window_start_s(self) -> float:
+        """When its planned window begins (``end_s - duration_s``; a task
+        without times has none that means anything)."""
+        return self.end_s - self.duration_s
+
 
 class PickTask(TaskBase, frozen=True, kw_only=True, tag="pick"):
     """Fly to a tool station and grab ``tool`` (takes ``pick_s``)."""

@@ -250,8 +250,9 @@ def place_monitor(ctx: Ctx, a: MonitorAction) -> None:
                 break
         if best is not None:
             break
-    if promised is not None and (best is None or best[1] > promised) and _keep_start(ctx, a, uids):
-        return  # the earlier start did not work out: the promise stands
+    retry = promised is not None and not keep and (best is None or best[1] > promised)
+    if retry and _keep_start(ctx, a, uids):
+        return  # the earlier start did not work out: the promise stands (not tried yet)
     if best is None:
         ctx.add_unplaced(a.id, None, "monitor_coverage_infeasible")
         return

@@ -48,12 +48,14 @@ class ReadyTimes:
         self._takeoff_s = ctx.problem.takeoff_s
         self._pos = pos = slot_position(a, 0)
         self.bound: dict[str, float] = {}
+        self._flight: dict[str, float] = {}  # direct arrival, take-off not counted
         self._direct: set[str] = set()  # can come now for at least ``min_seg_s``
         self._heap: list[tuple[float, bool, str]] = []
         for uid in uids:
             r = ctx.routes[uid]
             st = r.tail()
             arr, e_at = direct_arrival(r.kin, st, pos, base)
+            self._flight[uid] = arr
             if st.landed:
                 arr += self._takeoff_s
             self.bound[uid] = arr
@@ -72,10 +74,9 @@ class ReadyTimes:
         leg_wh = hold_floor_wh(k, ctx.site, self._pos, 0.0) - k.reserve_wh
         usable_wh = k.capacity_wh - 2 * leg_wh - k.reserve_wh
         hold_s = min(self._duration_s, HOLD_SHARE * usable_wh / max(k.hover_whps, 1e-12))
-        direct = direct_arrival(k, st, self._pos, self.base)[0]
         for need_s in (hold_s, self._min_seg_s):
             t = monitor_ready(k, ctx.site, ctx.pads, st, self._pos, self.base, (uid, st.t), need_s)
-            if t is not None and (st.landed or t > direct + 1e-9):  # leaves a pad first
+            if t is not None and (st.landed or t > self._flight[uid] + 1e-9):  # leaves a pad
                 t += self._takeoff_s
             if t is not None or need_s <= self._min_seg_s:
                 return t

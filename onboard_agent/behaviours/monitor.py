@@ -64,4 +64,4 @@ def _in_window(task: MonitorTask, now_s: float) -> bool:
     """Whether ``now_s`` lies in the task's planned window (always, for a
     task without times): seconds on station before the window (a relief
     that arrived early) are not this task's work."""
-    return task.end_s <= 0 or task.end_s - task.duration_s <= now_s
+    return task.end_s <= 0 or task.window_start_s <= now_s

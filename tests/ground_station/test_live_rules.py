@@ -174,7 +174,7 @@ def test_a_segment_handed_over_names_its_relief_and_the_last_names_none(gs):
     assert len(segments) >= 3
     for (task, uav), (after, relief) in itertools.pairwise(segments):
         assert task.relieved_by == relief != uav
-        assert abs(after.end_s - after.duration_s - task.end_s) <= 5.0
+        assert abs(after.window_start_s - task.end_s) <= 5.0
     assert segments[-1][0].relieved_by is None
 
 
