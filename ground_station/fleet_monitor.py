@@ -228,7 +228,11 @@ class FleetMonitor:
             airborne = t.flight_state in AIRBORNE
             entries.append(
                 TrafficEntry(
-                    uav_id=uav_id, position=t.position, airborne=airborne, age_s=now_s - seen
+                    uav_id=uav_id,
+                    position=t.position,
+                    airborne=airborne,
+                    age_s=now_s - seen,
+                    target=t.target,
                 )
             )
         return Traffic(uavs=entries)

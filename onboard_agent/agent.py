@@ -214,4 +214,5 @@ class Agent:
             armed=vehicle.armed,
             mode=vehicle.mode,
             tool=ctx.tool,
+            target=None if vehicle.landed else ctx.heading_to,
         )

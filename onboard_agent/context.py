@@ -11,13 +11,14 @@ import dataclasses
 import time
 from collections.abc import Callable
 
-from onboard_agent.autopilot.protocol import Autopilot, VehicleState
+from onboard_agent.autopilot.protocol import Autopilot, Pending, VehicleState
 from onboard_agent.config import AgentConfig
 from onboard_agent.energy import EnergyModel
 from onboard_agent.mission import Mission
 from onboard_agent.spots import Spots
 from onboard_agent.surroundings import Surroundings
 from onboard_agent.traffic import Traffic
+from proto.geo import Point
 
 
 @dataclasses.dataclass(kw_only=True, eq=False)
@@ -39,8 +40,16 @@ class Context:
     recharging: bool = False  # a battery-low recharge runs until the battery is full
     emergency: str = ""  # why the emergency protocol is active ("" when not)
     holding_for: str | None = None  # the UAV at our next point: we hold until it leaves
+    heading_to: Point | None = None  # the last position target sent (None: since a take-off)
     link_clock: Callable[[], float] = time.monotonic  # real seconds: link timeouts
 
     @property
     def vehicle(self) -> VehicleState:
         return self.autopilot.state
+
+    def goto(self, target: Point) -> Pending:
+        """Send the autopilot a position target, remembered in
+        ``heading_to``: telemetry reports it, since a UAV whose agent hangs
+        flies on to it while the ground station hears no more of it."""
+        self.heading_to = target
+        return self.autopilot.goto(target)

@@ -16,6 +16,10 @@ from proto.telemetry import Traffic as TrafficReport
 STALE_S = 60.0
 """A report entry older than this (as heard by the ground station, plus the
 time since the report came) is forgotten."""
+UNHEARD_S = 1.0
+"""An entry older than this (five telemetry periods) may have flown on to
+the target it was flying to: it holds that point too (a hung agent's
+autopilot flies on to its last target)."""
 
 
 class Traffic:
@@ -45,14 +49,19 @@ class Traffic:
         )
 
     def holder(self, point: Point, radius_m: float, now_s: float) -> str | None:
-        """Another airborne UAV within ``radius_m`` of ``point``, if any (the nearest)."""
+        """Another airborne UAV within ``radius_m`` of ``point``, if any (the
+        nearest): where it was heard, or, unheard for ``UNHEARD_S``, the
+        target it was flying to."""
         if self._report is None:
             return None
         since = now_s - self._received_s
-        near = [
-            (e.position.distance_to(point), e.uav_id)
-            for e in self._report.uavs
-            if e.airborne and e.uav_id != self.uav_id and e.age_s + since <= STALE_S
-        ]
+        near = []
+        for e in self._report.uavs:
+            age = e.age_s + since
+            if not e.airborne or e.uav_id == self.uav_id or age > STALE_S:
+                continue
+            near.append((e.position.distance_to(point), e.uav_id))
+            if e.target is not None and age > UNHEARD_S:
+                near.append((e.target.distance_to(point), e.uav_id))
         near = [n for n in near if n[0] < radius_m]
         return min(near)[1] if near else None

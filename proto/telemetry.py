@@ -39,16 +39,21 @@ class Telemetry(Message, frozen=True, kw_only=True):
     armed: bool = False
     mode: Text = ""
     tool: Id | None = None
+    target: Point | None = None
+    """The position target the agent last sent its autopilot (None on the
+    ground and while taking off): a UAV whose agent hangs flies on to it."""
 
 
 class TrafficEntry(Record, frozen=True, kw_only=True):
     """One UAV as the ground station last heard it, ``age_s`` before the
-    report was sent."""
+    report was sent: where it was and the position target it was flying to
+    (where it may be by now if it is no longer heard)."""
 
     uav_id: Id
     position: Point
     airborne: bool
     age_s: NonNegative = 0.0
+    target: Point | None = None
 
 
 class Traffic(Message, frozen=True, kw_only=True):

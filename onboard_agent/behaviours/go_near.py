@@ -141,6 +141,7 @@ class GoNear(AgentBehaviour):
         else:
             self._climb_to = vehicle.position.z_m + ctx.config.takeoff_alt_m
             self.command.issue("takeoff", autopilot.takeoff(self._climb_to))
+            ctx.heading_to = None  # straight up from where it stands
             self._takeoff_at = ctx.clock()
             self.feedback_message = "taking off"
         return Status.RUNNING
@@ -164,7 +165,7 @@ class GoNear(AgentBehaviour):
         leg = route.next_leg(vehicle.position, point, obstacles, clear_m, self.target.cruise_z(ctx))
         moved = self._sent is None or self._sent.distance_to(leg) > config.follow_threshold_m
         if moved or now - self._sent_at >= config.goto_resend_s:
-            ctx.autopilot.goto(leg)
+            ctx.goto(leg)
             self._sent, self._sent_at = leg, now
         distance = self.target.distance(ctx, point)
         self.feedback_message = f"flying to {self.target.label}, {distance:.1f} m"
@@ -191,7 +192,7 @@ class GoNear(AgentBehaviour):
         ctx.holding_for = other
         if self._sent is None or now - self._sent_at >= config.goto_resend_s:
             self._sent = self._sent or here
-            ctx.autopilot.goto(self._sent)
+            ctx.goto(self._sent)
             self._sent_at = now
         self.feedback_message = f"holding off: {other} is at the {self.target.label}"
         return True

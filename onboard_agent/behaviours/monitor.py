@@ -49,7 +49,7 @@ class Monitor(AgentBehaviour):
         config = ctx.config
         moved = self._sent is None or self._sent.distance_to(slot) > config.follow_threshold_m
         if moved or now - self._sent_at >= config.goto_resend_s:
-            ctx.autopilot.goto(slot)
+            ctx.goto(slot)
             self._sent, self._sent_at = slot, now
         if over:
             self.feedback_message = f"watching {task.worker_id} until {task.relieved_by} is there"

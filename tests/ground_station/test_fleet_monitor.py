@@ -3,6 +3,7 @@ heard again), long ones make a UAV lost, its return makes it back."""
 
 from __future__ import annotations
 
+import msgspec
 import pytest
 
 from ground_station.fleet_monitor import Change, FleetMonitor, unknown_tasks
@@ -156,6 +157,15 @@ def test_traffic_says_where_each_uav_was_heard_and_for_how_long_lost_ones_too():
     entries = {e.uav_id: (e.airborne, e.age_s) for e in report.uavs}
     assert entries == {"u1": (True, 2.0), "u2": (False, 2.0), "u3": (True, 12.0)}  # u4: never heard
     assert [e.uav_id for e in monitor.traffic(75.0).uavs] == []  # all older than a minute
+
+
+def test_traffic_passes_on_the_target_each_uav_was_flying_to():
+    monitor = FleetMonitor(["u1"], 5.0)
+    target = Point(x_m=3.0, y_m=4.0, z_m=5.0)
+    sample = msgspec.structs.replace(telemetry("u1", FlightState.FLYING), target=target)
+    monitor.on_telemetry(sample, 10.0)
+    [entry] = monitor.traffic(11.0).uavs
+    assert entry.target == target
 
 
 class Clocks:
