@@ -2,8 +2,9 @@
 
 from __future__ import annotations
 
+import contextlib
 import logging
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 
 from ground_station.store import Store, StoreUnavailable
 from proto.events import EventKind, GsEvent
@@ -17,7 +18,9 @@ class EventLog:
 
     An event the store cannot take is still published and kept in order
     until :meth:`flush` (each emit, and the watchdog) stores it: what
-    happened is never lost to a full disk, nor does it stop what follows."""
+    happened is never lost to a full disk, nor does it stop what follows.
+    Events emitted in a :meth:`batch` are stored in one transaction and
+    published at its end (one disk sync, not one per event)."""
 
     def __init__(
         self, store: Store, publish: Callable[[GsEvent], None], clock: Callable[[], float]
@@ -28,6 +31,7 @@ class EventLog:
         self._seq = store.last_event_seq()
         self._unstored: list[GsEvent] = []
         self._said = False  # the store's failure was logged
+        self._batch: list[GsEvent] | None = None  # emitted in the open batch, to publish
 
     @property
     def unstored(self) -> int:
@@ -66,19 +70,38 @@ class EventLog:
             detail=detail,
         )
         self._unstored.append(event)
+        if self._batch is not None:
+            self._batch.append(event)
+            return event
         self.flush()
         self._publish(event)
         return event
 
+    @contextlib.contextmanager
+    def batch(self) -> Iterator[None]:
+        """Emit several events, stored together and published at the end."""
+        if self._batch is not None:  # already in one
+            yield
+            return
+        self._batch = []
+        try:
+            yield
+        finally:
+            emitted, self._batch = self._batch, None
+            self.flush()
+            for event in emitted:
+                self._publish(event)
+
     def flush(self) -> None:
-        """Store the events not stored yet, oldest first, while the store takes them."""
-        while self._unstored:
-            try:
-                self._store.append_event(self._unstored[0])
-            except StoreUnavailable as exc:
-                if not self._said:
-                    log.error("events wait for the store: %s", exc)
-                self._said = True
-                return
-            self._unstored.pop(0)
+        """Store the events not stored yet, in one transaction, if the store takes them."""
+        if not self._unstored:
+            return
+        try:
+            self._store.append_events(self._unstored)
+        except StoreUnavailable as exc:
+            if not self._said:
+                log.error("events wait for the store: %s", exc)
+            self._said = True
+            return
+        self._unstored.clear()
         self._said = False

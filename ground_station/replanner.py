@@ -249,17 +249,19 @@ class Replanner:
             except StoreUnavailable:
                 self.live.invalidate()  # the session holds a plan that was not adopted
                 raise
-            for plan in changed:
+            for plan in changed:  # every plan out first: the events' disk sync waits
                 self._hold(plan)
                 if self.monitor.available(plan.uav_id) or plan.uav_id in self._resend:
                     self.send(plan)
                     self.stats.plans_sent += 1
-                self.events.emit(
-                    EventKind.PLAN_CHANGED,
-                    uav_id=plan.uav_id,
-                    epoch=epoch,
-                    detail=f"{len(plan.tasks)} tasks",
-                )
+            with self.events.batch():
+                for plan in changed:
+                    self.events.emit(
+                        EventKind.PLAN_CHANGED,
+                        uav_id=plan.uav_id,
+                        epoch=epoch,
+                        detail=f"{len(plan.tasks)} tasks",
+                    )
             self._resend.difference_update(changed_ids)
         self.stats.count += 1
         self.stats.total_s += elapsed

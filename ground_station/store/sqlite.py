@@ -143,11 +143,12 @@ class Store:
         ).fetchone()
         return codec.decode(row[0], Plan) if row else None
 
-    def append_event(self, event: GsEvent) -> None:
-        """Store one event (its ``seq`` must be new)."""
+    def append_events(self, events: list[GsEvent]) -> None:
+        """Store events (their ``seq`` must be new) in one transaction: all or none."""
         with self._transaction():
-            self._conn.execute(
-                "INSERT INTO events (seq, event) VALUES (?, ?)", (event.seq, codec.encode(event))
+            self._conn.executemany(
+                "INSERT INTO events (seq, event) VALUES (?, ?)",
+                [(event.seq, codec.encode(event)) for event in events],
             )
 
     def events(self, after_seq: int = 0, limit: int = 100) -> list[GsEvent]:

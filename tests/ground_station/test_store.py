@@ -90,6 +90,6 @@ def test_latest_plan_per_uav_and_counters(path):
 def test_events_are_paged_by_sequence(path):
     store = Store(path)
     for seq in range(1, 6):
-        store.append_event(GsEvent(seq=seq, stamp_s=seq, kind=EventKind.REPLAN))
+        store.append_events([GsEvent(seq=seq, stamp_s=seq, kind=EventKind.REPLAN)])
     assert [e.seq for e in store.events(after_seq=2, limit=2)] == [3, 4]
     assert store.last_event_seq() == 5
