@@ -85,9 +85,6 @@ def test_the_checker_flags_what_the_simulator_saw_as_unsafe_once_each():
     assert len(checker.excused) == 1 and "battery fault" in checker.excused[0]
 
 
-# Opt-in (-m chaos_long) until the emergency separation defect is fixed (issue 21): it
-# passed on one clean-clone CI run and recorded a violation on the next.
-@pytest.mark.chaos_long
 def test_a_short_seeded_run_reports_zero_violations(tmp_path, capsys):
     code = main(
         [

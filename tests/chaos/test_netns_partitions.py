@@ -279,9 +279,6 @@ def _chaos(tmp_path, capsys, seed: int, duration_s: float, drain_s: float) -> tu
     return code, report
 
 
-# Opt-in (-m chaos_long) until the emergency separation defect is fixed (issue 21): on the
-# clean-clone CI machine this run recorded unsafe violations that pass on a quiet one.
-@pytest.mark.chaos_long
 def test_a_short_netns_chaos_run_reports_zero_violations(netns, tmp_path, capsys):
     code, report = _chaos(tmp_path, capsys, CI_SEED, 35, 40)
     for cut in ("partition uav-2 for 9.3 s", "partition ground-station", "partition gateway"):
