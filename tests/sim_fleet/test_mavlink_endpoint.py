@@ -163,11 +163,13 @@ def test_local_ned_flight_grab_and_deliver_a_tool(fleet, client):
             0, 1, 1, mavlink.MAV_FRAME_LOCAL_NED, 0b110111111000,
             north - 10.0, east + 10.0, -up, 0, 0, 0, 0, 0, 0, 0, 0,
         )  # fmt: skip
-        client.wait(
-            "GLOBAL_POSITION_INT",
-            lambda m: abs(m.relative_alt - up * 1000) < 50 and abs(m.vx) + abs(m.vy) < 5,
-            timeout_s=30,
-        )
+        lat, lon, _ = fleet.call(lambda: world.geo.to_geodetic((east, north, 0.0)))
+
+        def there(m):  # at the target and still (hovering before it moves is neither)
+            near = abs(m.lat - lat * 1e7) < 5 and abs(m.lon - lon * 1e7) < 5
+            return near and abs(m.relative_alt - up * 1000) < 50 and abs(m.vx) + abs(m.vy) < 5
+
+        client.wait("GLOBAL_POSITION_INT", there, timeout_s=30)
         pos = fleet.call(lambda: world.vehicle("uav1").position)
         assert pos == pytest.approx((east, north, up), abs=0.1)
 
