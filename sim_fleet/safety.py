@@ -43,6 +43,16 @@ class Violation:
     detail: str = ""
 
 
+def _pair(a: Vehicle, b: Vehicle, gap_m: float) -> str:
+    """Where two vehicles too close to each other were, for the record."""
+
+    def one(v: Vehicle) -> str:
+        x, y, z = v.position
+        return f"{v.id} {v.state.name.lower()} {v.mode.name} at ({x:.1f}, {y:.1f}, {z:.1f})"
+
+    return f"{gap_m:.2f} m apart: {one(a)}, {one(b)}"
+
+
 class SafetyMonitor:
     """Watches state transitions and distances; appends to ``violations``."""
 
@@ -94,9 +104,9 @@ class SafetyMonitor:
                     break
                 if not (a.airborne or b.airborne):
                     continue  # two on the ground: side by side on a station
-                if math.dist(a.position, b.position) < sep:
+                if (gap := math.dist(a.position, b.position)) < sep:
                     lo, hi = (a, b) if a.id < b.id else (b, a)
                     close.add((lo.id, hi.id))
                     if (lo.id, hi.id) not in self._too_close:
-                        self._record(SEPARATION, lo, time_s, hi.id)
+                        self._record(SEPARATION, lo, time_s, f"{hi.id} {_pair(lo, hi, gap)}")
         self._too_close = close

@@ -6,6 +6,7 @@ import dataclasses
 import itertools
 import math
 import random
+import re
 
 import proto
 from proto.codec import decode, encode
@@ -19,7 +20,12 @@ from tests.sim_fleet.helpers import QUAD, airborne, command, run_until, scenario
 
 
 def kinds(w):
-    return [(v.kind, v.vehicle_id, v.detail) for v in w.violations]
+    return [(v.kind, v.vehicle_id, _other(v)) for v in w.violations]
+
+
+def _other(v) -> str:
+    """A separation's other vehicle (its detail begins with it), else the detail."""
+    return v.detail.split()[0] if v.kind == "separation" else v.detail
 
 
 def goto(w, v, target):
@@ -117,6 +123,11 @@ def test_separation_recorded_once_under_the_lower_id():
     goto(w, u2, (0.6, 0.0, 10.0))  # u2 comes to u1 (S1 at the origin)
     w.step(10.0)
     assert kinds(w) == [("separation", "u1", "u2")]
+    # where both were and what they did: a chaos report must be diagnosable
+    assert re.fullmatch(
+        r"u2 0\.\d\d m apart: u1 flying \w+ at \(.+\), u2 flying \w+ at \(.+\)",
+        w.violations[0].detail,
+    ), w.violations[0].detail
     goto(w, u2, (0.0, 0.0, 11.5))  # 1.5 m: clear again
     goto(w, u2, (0.0, 0.3, 10.5))
     assert kinds(w) == [("separation", "u1", "u2")] * 2
@@ -172,7 +183,7 @@ def test_pairwise_sweep_finds_exactly_the_close_pairs():
     vehicles[1].position = (vehicles[0].position[0] + 0.5, *vehicles[0].position[1:])
     monitor = SafetyMonitor(SafetyRules(separation_m=1.0), [], 1.0)
     monitor.check(vehicles, {}, 0.0)
-    found = {(v.vehicle_id, v.detail) for v in monitor.violations}
+    found = {(v.vehicle_id, _other(v)) for v in monitor.violations}
     want = {
         tuple(sorted((a.id, b.id)))
         for a, b in itertools.combinations(vehicles, 2)
