@@ -3,6 +3,10 @@
 hovers at: the last line of separation after the plan's own (hold points
 taken in turn, distinct slots, spots) when a plan is stale or a UAV hangs.
 
+A UAV unheard for a while (its agent hung or cut off) may hover where it
+was or at the target it was flying to: a route passes both as it passes
+people (:mod:`onboard_agent.route`).
+
 Ages are in real seconds (the link clock), whatever the mission's speed-up.
 Without a report (the ground station is away) nothing is known: the agent
 flies its plan as before.
@@ -36,32 +40,40 @@ class Traffic:
 
     def position(self, uav_id: str, now_s: float) -> Point | None:
         """Where ``uav_id`` was last heard airborne, if the report says so."""
-        if self._report is None:
-            return None
-        since = now_s - self._received_s
-        return next(
-            (
-                e.position
-                for e in self._report.uavs
-                if e.uav_id == uav_id and e.airborne and e.age_s + since <= STALE_S
-            ),
-            None,
-        )
+        return next((where for u, where, _ in self._others(now_s) if u == uav_id), None)
 
     def holder(self, point: Point, radius_m: float, now_s: float) -> str | None:
         """Another airborne UAV within ``radius_m`` of ``point``, if any (the
         nearest): where it was heard, or, unheard for ``UNHEARD_S``, the
         target it was flying to."""
+        near = [
+            (where.distance_to(point), uav_id)
+            for uav_id, where, _unheard in self._others(now_s)
+            if where.distance_to(point) < radius_m
+        ]
+        return min(near)[1] if near else None
+
+    def unheard(self, now_s: float) -> list[Point]:
+        """Where other airborne UAVs unheard for ``UNHEARD_S`` may hover: where
+        they were heard and the targets they flew to (a route passes them as
+        it passes people; one that is heard moves on, and is kept clear of at
+        the point it flies to)."""
+        return [where for _uav, where, unheard in self._others(now_s) if unheard]
+
+    def _others(self, now_s: float) -> list[tuple[str, Point, bool]]:
+        """(UAV, a point it may be at, whether it is unheard) for the other
+        airborne UAVs of the report: where each was heard, and the target
+        of each unheard one."""
         if self._report is None:
-            return None
+            return []
         since = now_s - self._received_s
-        near = []
+        out = []
         for e in self._report.uavs:
             age = e.age_s + since
             if not e.airborne or e.uav_id == self.uav_id or age > STALE_S:
                 continue
-            near.append((e.position.distance_to(point), e.uav_id))
-            if e.target is not None and age > UNHEARD_S:
-                near.append((e.target.distance_to(point), e.uav_id))
-        near = [n for n in near if n[0] < radius_m]
-        return min(near)[1] if near else None
+            unheard = age > UNHEARD_S
+            out.append((e.uav_id, e.position, unheard))
+            if e.target is not None and unheard:
+                out.append((e.uav_id, e.target, True))
+        return out

@@ -161,7 +161,11 @@ class GoNear(AgentBehaviour):
         if self._yielding(point, now):
             return Status.RUNNING
         clear_m = ctx.surroundings.site.safety.people_clearance_m + config.route_margin_m
-        obstacles = ctx.surroundings.people() + ctx.spots.raised_spots(ctx.surroundings.site)
+        obstacles = (
+            ctx.surroundings.people()
+            + ctx.spots.raised_spots(ctx.surroundings.site)
+            + ctx.traffic.unheard(ctx.link_clock())
+        )
         leg = route.next_leg(vehicle.position, point, obstacles, clear_m, self.target.cruise_z(ctx))
         moved = self._sent is None or self._sent.distance_to(leg) > config.follow_threshold_m
         if moved or now - self._sent_at >= config.goto_resend_s:

@@ -272,3 +272,23 @@ def test_a_uav_no_longer_heard_is_kept_clear_of_at_the_target_it_flew_to():
     rig.tick(2, arrive=False)
     assert rig.agent.status().holding_for == "uav-2"
     assert last_goto(rig).distance_to(slot) > 2.0
+
+
+def test_a_route_passes_over_a_uav_no_longer_heard_that_hovers_on_its_way():
+    """A hung agent's UAV hovers where it was (chaos seed 12: another UAV
+    flew past it, closer than the separation): the route climbs over it,
+    as over a person; one just heard is not in the way (it moves on)."""
+    rig = Rig(position=point(W2.x_m + 24.0, W2.y_m, W2.z_m + 3.0))
+    rig.autopilot.update(flight_state=rig.autopilot.state.flight_state.FLYING, armed=True)
+    rig.agent.offer_plan(plan(monitor(slot=0, slots=1, duration_s=30.0)))
+    midway = point(W2.x_m + 14.0, W2.y_m, W2.z_m + 3.0)  # on the straight way to the slot
+    heard = TrafficEntry(uav_id="uav-2", position=midway, airborne=True, age_s=0.2)
+    rig.agent.ctx.traffic.update(Traffic(uavs=[heard]), rig.clock())
+    rig.tick(2, arrive=False)
+    assert last_goto(rig).x_m == pytest.approx(W2.x_m + 4.0)  # straight for the slot
+    unheard = msgspec.structs.replace(heard, age_s=5.0)
+    rig.agent.ctx.traffic.update(Traffic(uavs=[unheard]), rig.clock())
+    rig.tick(2, arrive=False)
+    climb = last_goto(rig)
+    assert (climb.x_m, climb.y_m) == pytest.approx((W2.x_m + 24.0, W2.y_m))  # up first
+    assert climb.z_m >= midway.z_m + 2.0
