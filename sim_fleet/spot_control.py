@@ -14,6 +14,7 @@ from __future__ import annotations
 import asyncio
 import dataclasses
 import logging
+import math
 import time
 from collections.abc import Iterable
 
@@ -29,6 +30,10 @@ log = logging.getLogger(__name__)
 
 GRANT_TTL_S = 600.0
 """Simulated seconds a granted UAV has to land on its spot."""
+CLEAR_M = 4.0
+"""A UAV that took off from a spot keeps it taken until it is this far from
+it (3-D): one granted it next would otherwise come down onto a UAV still
+climbing out (take-off climbs 3 m straight up)."""
 
 
 @dataclasses.dataclass
@@ -72,8 +77,10 @@ class SpotControl:
         return True
 
     def observe(self, vehicles: Iterable[Vehicle], now_s: float) -> None:
-        """Who sits where now; grants whose UAV took off or never came end."""
-        on_ground = [v for v in vehicles if not v.airborne]
+        """Who sits where now (or still climbs out: ``CLEAR_M``); grants
+        whose UAV took off or never came end."""
+        crafts = {v.id: v for v in vehicles}
+        on_ground = [v for v in crafts.values() if not v.airborne]
         for station_id, points in self.spots.items():
             for i, point in enumerate(points):
                 sitter = next(
@@ -84,7 +91,14 @@ class SpotControl:
                     ),
                     None,
                 )
-                self.landed[station_id][i] = sitter
+                last = crafts.get(self.landed[station_id][i] or "")
+                climbing = (
+                    sitter is None
+                    and last is not None
+                    and last.airborne
+                    and math.dist(last.position, point) < CLEAR_M
+                )
+                self.landed[station_id][i] = last.id if climbing and last else sitter
                 grant = self.grants[station_id][i]
                 if grant is None:
                     continue

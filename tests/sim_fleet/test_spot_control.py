@@ -45,7 +45,7 @@ def test_a_grant_ends_on_take_off_on_another_claim_on_release_or_when_unused():
     control.observe([uav1], 100.0)
     assert control.state("C1").granted[0] == "uav-1"
     uav1.airborne = True
-    control.observe([uav1], 101.0)  # took off: the spot is free again
+    control.observe([uav1], 101.0)  # took off: the grant ends
     assert control.state("C1").granted == [None, None]
     control.claim("uav-1", "C1", 1, 102.0)
     control.claim("uav-1", "C2", 0, 103.0)  # another claim ends the first
@@ -84,3 +84,23 @@ def test_a_claim_is_trusted_only_from_the_key_of_the_uav_it_names():
     assert service.control.state("C2").granted == ["uav-1"]
     sent = dict(bus.published)
     assert sent[keys.station_spots("C2")].granted == ["uav-1"]  # answered at once
+
+
+def test_a_spot_stays_taken_until_the_uav_that_took_off_from_it_is_clear():
+    """Granted at once, the next UAV would come down onto one still climbing
+    out of the spot (chaos seed 11: uav-1 landing at C2 as uav-2 left it)."""
+    control = SpotControl(SPOTS, dock_radius_m=1.0)
+    uav2 = Craft("uav-2", (0.0, 20.0, 0.0), airborne=False)
+    control.observe([uav2], 0.0)
+    uav2.airborne, uav2.position = True, (0.0, 20.0, 2.5)  # climbing out
+    control.observe([uav2], 1.0)
+    assert control.state("C2").landed == ["uav-2"]
+    assert not control.claim("uav-1", "C2", 0, 1.0)
+    uav2.position = (3.0, 20.0, 3.0)  # on its way: 4.2 m from the spot
+    control.observe([uav2], 2.0)
+    assert control.state("C2").landed == [None]
+    assert control.claim("uav-1", "C2", 0, 2.0)
+    control.observe([uav2], 3.0)  # gone for good: not taken again
+    uav2.position = (0.5, 20.0, 3.0)  # even if it passes back over the spot
+    control.observe([uav2], 4.0)
+    assert control.state("C2").landed == [None]
