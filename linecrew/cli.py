@@ -18,7 +18,7 @@ from collections.abc import Iterator
 
 # name -> ("module:function", help). The function takes argv and returns an exit code.
 COMMANDS: dict[str, tuple[str, str]] = {
-    "router": ("ground_station.router:main", "run the ground site's Zenoh router"),
+    "router": ("linecrew.bus.router:main", "run the ground site's Zenoh router"),
     "ground-station": ("ground_station.main:main", "run the mission manager and planner"),
     "sim": ("sim_fleet.main:main", "run the MAVLink fleet simulator and human tracker"),
     "agent": ("onboard_agent.main:main", "run one UAV's onboard agent (or: agent tree)"),
@@ -42,12 +42,15 @@ COMMANDS: dict[str, tuple[str, str]] = {
     "export": ("linecrew.report.cli:export_main", "print a run's events and actions as JSON lines"),
 }
 BENCHES: dict[str, tuple[str, str]] = {
-    "bus": ("linecrew.bus.bench:main", "Zenoh bus latency, throughput, liveliness"),
-    "ground-station": ("ground_station.bench:main", "event-to-plan latency, loss detection"),
-    "sim": ("sim_fleet.bench:main", "simulator physics rate, telemetry rate, CPU"),
-    "planner": ("ground_station.planner.cli:bench_main", "planner speed and plan quality"),
-    "live-plan": ("ground_station.bench_quality:main", "the live plan against the offline one"),
-    "fleet": ("linecrew.launch.bench_fleet:main", "start-up, CPU, RSS, latencies of N UAVs"),
+    "bus": ("linecrew.bench.bus:main", "Zenoh bus latency, throughput, liveliness"),
+    "ground-station": (
+        "linecrew.bench.ground_station:main",
+        "event-to-plan latency, loss detection",
+    ),
+    "sim": ("linecrew.bench.sim:main", "simulator physics rate, telemetry rate, CPU"),
+    "planner": ("linecrew.planner_tools.cli:bench_main", "planner speed and plan quality"),
+    "live-plan": ("linecrew.bench.live_plan:main", "the live plan against the offline one"),
+    "fleet": ("linecrew.bench.fleet:main", "start-up, CPU, RSS, latencies of N UAVs"),
 }
 
 

@@ -7,7 +7,6 @@
 
 from ground_station.planner.api import plan, score
 from ground_station.planner.errors import PlanningProblemError
-from ground_station.planner.generator import generate
 from ground_station.planner.load import (
     check_problem,
     plan_from_json,
@@ -77,7 +76,6 @@ __all__ = [
     "Waypoint",
     "check_problem",
     "compute_metrics",
-    "generate",
     "plan",
     "plan_from_json",
     "problem_from_json",

@@ -126,7 +126,7 @@ class NetnsRun:
         self.url = f"http://{self.address('gateway')}:{GATEWAY_PORT}"
         token_file = self.run_dir / "token"
         site = ["--site", self.keys.site]
-        sup.start("router", "ground_station.router", "--listen", self.endpoint, *site, *lease)
+        sup.start("router", "linecrew.bus.router", "--listen", self.endpoint, *site, *lease)
         self._wait("router")
         self.bus = Bus.open(BusConfig(connect=(self.endpoint,), lease_ms=opts.lease_ms))
         db = ["--db", str(self.run_dir / "gs.db")]

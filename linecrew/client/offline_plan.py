@@ -23,10 +23,10 @@ import yaml
 
 import ground_station.planner as planner_pkg
 import linecrew.scenarios as scenarios_pkg
-from ground_station.planner.cli import plan_main as planner_main
 from ground_station.planner.errors import PlanningProblemError
 from ground_station.planner.load import problem_from_obj
 from ground_station.planning import UavNow, build_problem
+from linecrew.planner_tools.cli import plan_main as planner_main
 from linecrew.scenarios import ScenarioError, load
 from proto.mission import ActionRecord, ActionState
 from proto.scenario import Scenario

@@ -132,7 +132,7 @@ class LocalRun:
 
         router = sup.start(
             "router",
-            "ground_station.router",
+            "linecrew.bus.router",
             *(["--zenoh-config", profile.router_config()] if profile else []),
             "--listen",
             self.endpoint.replace("localhost", "127.0.0.1"),

@@ -83,7 +83,7 @@ def endpoint(pki: pathlib.Path) -> Iterator[str]:
     args = [
         sys.executable,
         "-m",
-        "ground_station.router",
+        "linecrew.bus.router",
         "--listen",
         f"tls/127.0.0.1:{port}",
         "--zenoh-config",

@@ -13,11 +13,12 @@ import msgspec
 import pytest
 
 from ground_station.live_plan import LivePlan
-from ground_station.planner import Plan, Problem, generate, validate
+from ground_station.planner import Plan, Problem, validate
 from ground_station.planner.export import export
 from ground_station.planner.heuristic import build
 from ground_station.planner.improve import improve
 from ground_station.planner.model import MonitorAction
+from linecrew.planner_tools.generator import generate
 
 
 def doubled(plan: Plan) -> list[tuple]:

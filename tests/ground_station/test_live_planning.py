@@ -9,8 +9,8 @@ import asyncio
 import dataclasses
 import random
 
-from ground_station.bench import random_inspection
 from ground_station.live_plan import accept, better_by, freeze_broken, frozen_tasks
+from linecrew.bench.ground_station import random_inspection
 from proto import (
     ActionState,
     AgentState,

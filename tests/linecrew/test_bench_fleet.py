@@ -7,7 +7,7 @@ import json
 import subprocess
 import sys
 
-from linecrew.launch.bench_fleet import table
+from linecrew.bench.fleet import table
 
 ROWS = [
     "agent processes",

@@ -112,7 +112,7 @@ def router_args(port: int, *extra: str) -> list[str]:
     return [
         sys.executable,
         "-m",
-        "ground_station.router",
+        "linecrew.bus.router",
         "--listen",
         f"tcp/127.0.0.1:{port}",
         *extra,

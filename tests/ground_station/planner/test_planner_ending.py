@@ -20,7 +20,7 @@ from ground_station.planner import (
     problem_from_obj,
     validate,
 )
-from ground_station.planner.generator import generate
+from linecrew.planner_tools.generator import generate
 
 replace = msgspec.structs.replace
 # 0.01 Wh/m, 40 Wh above the reserve: 4 km on a full battery.

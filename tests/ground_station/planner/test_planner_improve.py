@@ -7,10 +7,11 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from ground_station.planner import Options, generate, plan, score, validate
+from ground_station.planner import Options, plan, score, validate
 from ground_station.planner.export import export
 from ground_station.planner.heuristic import build
 from ground_station.planner.improve import improve, objective
+from linecrew.planner_tools.generator import generate
 
 
 @settings(max_examples=8, deadline=None)

@@ -4,7 +4,8 @@ from __future__ import annotations
 
 import pytest
 
-from ground_station.planner import Options, generate, plan, validate
+from ground_station.planner import Options, plan, validate
+from linecrew.planner_tools.generator import generate
 
 SIZES = ((2, 3), (3, 4), (3, 8), (4, 12), (5, 20), (6, 30), (10, 60))
 

@@ -23,7 +23,7 @@ from ground_station.planner import (
     plan,
     validate,
 )
-from ground_station.planner.generator import generate
+from linecrew.planner_tools.generator import generate
 
 SETTINGS = settings(max_examples=40, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 coord = st.floats(min_value=-1500, max_value=1500, allow_nan=False).map(lambda v: round(v, 1))

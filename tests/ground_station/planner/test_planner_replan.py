@@ -16,7 +16,6 @@ from ground_station.planner import (
     Waypoint,
     validate,
 )
-from ground_station.planner.generator import generate
 from ground_station.planner.replan import (
     ActionAdded,
     ActionCancelled,
@@ -28,6 +27,7 @@ from ground_station.planner.replan import (
     UavLost,
     replan_once,
 )
+from linecrew.planner_tools.generator import generate
 
 replace = msgspec.structs.replace
 NEW = InspectAction(

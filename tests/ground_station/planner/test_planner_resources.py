@@ -13,15 +13,15 @@ from ground_station.planner import (
     RunningTask,
     Station,
     Waypoint,
-    generate,
     plan,
     validate,
 )
-from ground_station.planner.bench import replan_times
 from ground_station.planner.export import export
 from ground_station.planner.heuristic import build
 from ground_station.planner.removal import remove_in_place
 from ground_station.planner.replan import ActionAdded, Session
+from linecrew.planner_tools.bench import replan_times
+from linecrew.planner_tools.generator import generate
 
 replace = msgspec.structs.replace
 

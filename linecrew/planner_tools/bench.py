@@ -27,8 +27,6 @@ from typing import Any
 import msgspec
 
 from ground_station.planner.api import plan, score
-from ground_station.planner.bench_reference import best_known, deadline, references
-from ground_station.planner.generator import FAMILIES, generate, ring_bearing
 from ground_station.planner.model import DeliverAction, MonitorAction, Problem
 from ground_station.planner.replan import (
     ActionAdded,
@@ -44,6 +42,8 @@ from ground_station.planner.replan import (
 from ground_station.planner.result import Plan
 from ground_station.planner.routes import Options
 from ground_station.planner.validate import validate
+from linecrew.planner_tools.bench_reference import best_known, deadline, references
+from linecrew.planner_tools.generator import FAMILIES, generate, ring_bearing
 
 DEFAULT_SIZES = ("3x4", "5x20", "10x50", "20x200", "50x500")
 

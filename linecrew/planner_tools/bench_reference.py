@@ -47,7 +47,7 @@ def references(
     }
     info: dict[str, Any] = {}
     if cpsat:
-        from ground_station.planner.reference import solve
+        from linecrew.planner_tools.reference import solve
 
         for kind, hint in (("cpsat-planner", improved), ("cpsat-paper", paper)):
             r = solve(problem, budget_ms / 1000.0, hint=hint)

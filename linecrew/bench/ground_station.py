@@ -249,7 +249,7 @@ def _silence_to_lost(
     watch: _EventWatch,
 ) -> dict[str, float]:
     code = (
-        f"from ground_station.bench import doomed_agent; "
+        f"from linecrew.bench.ground_station import doomed_agent; "
         f"doomed_agent({endpoint!r}, {scenario_file!r}, {uav_id!r}, {lease_ms})"
     )
     child = subprocess.Popen([sys.executable, "-c", code], stdout=subprocess.PIPE)

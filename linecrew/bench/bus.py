@@ -133,7 +133,7 @@ def _vanish_time(watcher: Bus, endpoint: str, lease_ms: int, sig: signal.Signals
     key = KEYS.alive(Role.AGENT, f"victim-{sig.name.lower()}")
     events: dict[bool, float] = {}
     code = (
-        f"from linecrew.bus.bench import hold_token; hold_token({endpoint!r}, {key!r}, {lease_ms})"
+        f"from linecrew.bench.bus import hold_token; hold_token({endpoint!r}, {key!r}, {lease_ms})"
     )
     with watcher.watch_liveliness(
         key, lambda _k, alive: events.setdefault(alive, time.perf_counter())

@@ -42,10 +42,10 @@ import msgspec
 
 from ground_station.planner.api import score
 from ground_station.planner.model import Problem
-from ground_station.planner.reference.cpsat import Model
-from ground_station.planner.reference.nodes import TICK_S, build_nodes, unsupported
-from ground_station.planner.reference.steps import export, route_literals
 from ground_station.planner.result import Plan
+from linecrew.planner_tools.reference.cpsat import Model
+from linecrew.planner_tools.reference.nodes import TICK_S, build_nodes, unsupported
+from linecrew.planner_tools.reference.steps import export, route_literals
 
 __all__ = ["Reference", "solve"]
 

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from sim_fleet.bench import run
+from linecrew.bench.sim import run
 
 
 def test_bench_reports_rates_and_cpu():

@@ -7,7 +7,7 @@ from pathlib import Path
 
 import pytest
 
-from ground_station.planner.cli import bench_main, plan_main
+from linecrew.planner_tools.cli import bench_main, plan_main
 
 EXAMPLE = Path(__file__).parents[3] / "ground_station" / "planner" / "examples" / "paper.yaml"
 

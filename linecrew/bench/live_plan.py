@@ -22,16 +22,16 @@ import time
 from pathlib import Path
 
 from ground_station import planner as pl
-from ground_station.bench import random_inspection
 from ground_station.event_log import EventLog
 from ground_station.fleet_monitor import FleetMonitor
 from ground_station.missions import MissionManager
 from ground_station.planner.api import score
-from ground_station.planner.cli import deadline
 from ground_station.planning import build_problem
 from ground_station.replan_jobs import ImproveSettings
 from ground_station.replanner import Replanner
 from ground_station.store import Store
+from linecrew.bench.ground_station import random_inspection
+from linecrew.planner_tools.cli import deadline
 from linecrew.scenarios import load, with_fleet_size
 from proto import FlightState, GeoPoint, Scenario, SubmitAction, Telemetry
 

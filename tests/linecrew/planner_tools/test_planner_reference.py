@@ -24,11 +24,11 @@ from ground_station.planner import (
     score,
     validate,
 )
-from ground_station.planner.cli import bench_main
-from ground_station.planner.generator import generate
+from linecrew.planner_tools.cli import bench_main
+from linecrew.planner_tools.generator import generate
 
 pytest.importorskip("ortools")
-from ground_station.planner.reference import solve
+from linecrew.planner_tools.reference import solve
 
 DRONE = UavType(
     id="quad",

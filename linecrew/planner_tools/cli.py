@@ -17,13 +17,13 @@ from rich.table import Table
 
 from ground_station.planner.api import plan
 from ground_station.planner.errors import PlanningProblemError
-from ground_station.planner.gantt import gantt, unplaced_table
 from ground_station.planner.load import plan_from_json, problem_from_json, problem_from_obj
 from ground_station.planner.metrics import compute_metrics
 from ground_station.planner.model import Problem
 from ground_station.planner.result import Plan
 from ground_station.planner.routes import Options
 from ground_station.planner.validate import validate
+from linecrew.planner_tools.gantt import gantt, unplaced_table
 
 
 def read_problem(path: str) -> Problem:
@@ -120,7 +120,7 @@ def plan_main(argv: list[str]) -> int:
 
 def bench_main(argv: list[str]) -> int:
     """``linecrew bench planner [--sizes ...] [--seeds ...] [--json]``."""
-    from ground_station.planner import bench
+    from linecrew.planner_tools import bench
 
     return bench.main(argv)
 

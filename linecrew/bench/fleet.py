@@ -34,7 +34,7 @@ import time
 
 import msgspec
 
-from ground_station.bench import random_inspection
+from linecrew.bench.ground_station import random_inspection
 from linecrew.latency import summary_ms
 from linecrew.launch.local_run import LocalRun, RunOptions
 from linecrew.launch.proc_stats import KINDS, measure

@@ -8,7 +8,7 @@ from math import dist
 import pytest
 
 from ground_station.planner import DeliverAction, MonitorAction, plan, validate
-from ground_station.planner.generator import FAMILIES, TYPES, generate, ring_bearing
+from linecrew.planner_tools.generator import FAMILIES, TYPES, generate, ring_bearing
 
 
 def test_the_default_family_is_the_corridor() -> None:

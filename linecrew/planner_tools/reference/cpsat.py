@@ -5,7 +5,7 @@ from __future__ import annotations
 from math import ceil, dist
 
 from ground_station.planner.model import MonitorAction, Problem, Uav
-from ground_station.planner.reference.nodes import Node, clusters, nodes_of, ticks, units
+from linecrew.planner_tools.reference.nodes import Node, clusters, nodes_of, ticks, units
 
 WEIGHT_SCALE = 100
 """Action weights are scaled to integers with this factor."""

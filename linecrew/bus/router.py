@@ -2,7 +2,7 @@
 that every other process connects to as a client. Declares the liveliness
 token ``alive/router/{id}`` as its health signal.
 
-Run: ``linecrew router --listen tcp/0.0.0.0:7447`` (or ``python -m ground_station.router``).
+Run: ``linecrew router --listen tcp/0.0.0.0:7447`` (or ``python -m linecrew.bus.router``).
 """
 
 from __future__ import annotations

@@ -8,9 +8,9 @@ import msgspec
 
 from ground_station.planner.metrics import compute_metrics
 from ground_station.planner.model import Station, Uav, UavType, Vec3
-from ground_station.planner.reference.cpsat import Model
-from ground_station.planner.reference.nodes import TICK_S, Node, ticks
 from ground_station.planner.result import Plan, Step, UavPlan
+from linecrew.planner_tools.reference.cpsat import Model
+from linecrew.planner_tools.reference.nodes import TICK_S, Node, ticks
 
 
 def export(m: Model, solver) -> Plan:  # type: ignore[no-untyped-def]
