@@ -1,8 +1,9 @@
 """Where this UAV may land at a charging station: the spot the station's
 controller granted it (:mod:`proto.spots`), claimed from the spots its
-feed shows free; until the grant comes, a hold point above the station, at
-a height of its own (``approach_alt_m`` plus ``HOLD_STEP_M`` per place in
-the fleet), so that UAVs waiting for one station never meet; flights to a
+feed shows free; until the grant comes, a hold point beside the station's
+row of spots (``HOLD_ASIDE_M``), at a height of its own (``approach_alt_m``
+plus ``HOLD_STEP_M`` per place in the fleet), so that UAVs waiting for one
+station never meet, nor meet one landing or taking off; flights to a
 station cross at that height too. A station whose controller has not been
 heard is landed on at its position, as before there were spots; one not
 heard for ``STALE_S`` (the UAV is cut off) on the spot its last feed showed
@@ -19,6 +20,11 @@ from proto.spots import SpotClaim, StationSpots, spot_positions
 
 HOLD_STEP_M = 2.0
 """Height between the hold points of two UAVs of the fleet."""
+HOLD_ASIDE_M = 3.0
+"""Hold points lie this far beside the station's row of spots (along +y;
+the spots run along +x): a UAV coming down to its spot or climbing out of
+one passes 3 m from the UAVs holding there, not through their column
+(chaos seed 11: one descending to its spot 0.96 m from one holding)."""
 CLAIM_EVERY_S = 1.0
 """A claim not granted yet is repeated this often (mission seconds)."""
 UNUSED_S = 5.0
@@ -100,10 +106,13 @@ class Spots:
         return None
 
     def hold_point(self, station: ChargingStation, approach_alt_m: float) -> Point:
-        """Where this UAV waits for a spot at ``station``."""
+        """Where this UAV waits for a spot at ``station``: beside its row of
+        spots (``HOLD_ASIDE_M``), at a height of its own."""
         p = station.position
         return Point(
-            x_m=p.x_m, y_m=p.y_m, z_m=p.z_m + approach_alt_m + HOLD_STEP_M * (1 + self.place)
+            x_m=p.x_m,
+            y_m=p.y_m + HOLD_ASIDE_M,
+            z_m=p.z_m + approach_alt_m + HOLD_STEP_M * (1 + self.place),
         )
 
     def claim_due(self, now_s: float) -> SpotClaim | None:

@@ -4,6 +4,8 @@ emergency goes to the nearest station with room."""
 
 from __future__ import annotations
 
+import math
+
 from onboard_agent.spots import STALE_S
 from proto.plan import RechargeTask
 from proto.spots import StationSpots, spot_positions
@@ -148,3 +150,13 @@ def test_before_its_position_is_known_a_uav_claims_no_spot_at_another_station():
     rig.tick(10)
     assert "takeoff" not in [name for name, _ in rig.autopilot.calls]  # stays on its pad
     assert rig.autopilot.state.landed and rig.autopilot.state.position == home
+
+
+def test_hold_points_stand_clear_of_the_column_above_every_spot():
+    """A UAV comes down to its spot (and climbs out of one) straight
+    through the heights others hold at: never through their column."""
+    spots = Rig().agent.ctx.spots
+    hold = spots.hold_point(C3, 3.0)
+    separation = SCENARIO.site.safety.separation_m
+    for spot in C3_SPOTS:
+        assert math.hypot(hold.x_m - spot.x_m, hold.y_m - spot.y_m) >= separation + 2.0
