@@ -64,7 +64,7 @@ class Agent:
             autopilot=autopilot,
             mission=Mission(uav_id, scenario.site, wall),
             surroundings=Surroundings(scenario.site),
-            spots=Spots(uav_id, scenario),
+            spots=Spots(uav_id, scenario, link_clock),
             traffic=Traffic(uav_id),
             energy=energy,
             clock=clock,

@@ -91,5 +91,6 @@ def can_reach_station(ctx: Context) -> bool:
     vehicle = ctx.vehicle
     if not vehicle.known or not vehicle.battery_known or vehicle.landed:
         return True  # unknown is no emergency; a landed UAV draws nothing: it recharges instead
-    needed = to_station_wh(ctx, ctx.vehicle.position) + ctx.energy.reserve_wh
-    return available_wh(ctx) >= needed
+    station = ctx.surroundings.nearest_station(vehicle.position)
+    where = station.position if station is not None else vehicle.position
+    return ctx.energy.reaches(vehicle.battery_fraction, vehicle.position, where)

@@ -84,7 +84,7 @@ class Comms:
         async with self.bus.subscribe_async(self.keys.all_station_spots(), StationSpots) as sub:
             async for key, feed in sub:
                 if self._trusted(key, "station", feed.station_id):
-                    self.agent.ctx.spots.update(feed, self.agent.ctx.clock())
+                    self.agent.ctx.spots.update(feed)
 
     async def _traffic(self) -> None:
         async with self.bus.subscribe_async(self.keys.traffic(), TrafficReport) as sub:

@@ -43,3 +43,7 @@ class EnergyModel:
     def energy_wh(self, fraction: float) -> float:
         """Energy in the pack at state of charge ``fraction``."""
         return fraction * self.capacity_wh
+
+    def reaches(self, fraction: float, a: Point, b: Point) -> bool:
+        """Whether a pack at ``fraction`` flies from ``a`` to ``b`` and keeps the reserve."""
+        return self.energy_wh(fraction) >= self.travel_wh(a, b) + self.reserve_wh

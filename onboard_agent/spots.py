@@ -4,19 +4,27 @@ feed shows free; until the grant comes, a hold point beside the station's
 row of spots (``HOLD_ASIDE_M``), at a height of its own (``approach_alt_m``
 plus ``HOLD_STEP_M`` per place in the fleet), so that UAVs waiting for one
 station never meet, nor meet one landing or taking off; flights to a
-station cross at that height too. A station whose controller has not been
-heard is landed on at its position, as before there were spots; one not
-heard for ``STALE_S`` (the UAV is cut off) on the spot its last feed showed
-free, so that a partition never keeps a UAV in the air."""
+station cross at that height too.
+
+A station whose controller is unheard for ``STALE_S`` real seconds (the UAV
+is cut off, or the station has no controller) is landed on unannounced, so
+that a partition never keeps a UAV in the air: at home on the UAV's own
+home spot, which no other UAV is ever granted (cut-off UAVs therefore go
+home when they can reach it, see :func:`onboard_agent.targets.landing_station`);
+elsewhere on a shared spot the last feed showed free, the UAV's place in
+the fleet choosing among several so that two cut-off UAVs seldom pick
+the same one. Never between spots."""
 
 from __future__ import annotations
 
 import math
+import time
+from collections.abc import Callable
 
 from proto.geo import Point
 from proto.scenario import Scenario
 from proto.site import ChargingStation, Site
-from proto.spots import SpotClaim, StationSpots, spot_positions
+from proto.spots import SpotClaim, StationSpots, spot_owners, spot_positions
 
 HOLD_STEP_M = 2.0
 """Height between the hold points of two UAVs of the fleet."""
@@ -30,18 +38,29 @@ CLAIM_EVERY_S = 1.0
 UNUSED_S = 5.0
 """A grant the UAV has not flown to for this long is given back, and a
 wanted spot not asked for again for this long is no longer claimed."""
-STALE_S = 10.0
-"""A station feed older than this (mission seconds) no longer gates landing."""
+STALE_S = 3.0
+"""A station feed unheard this long (real seconds, as the ground-station
+link's timeout: a speed-up must not shorten it) no longer gates landing."""
 
 
 class Spots:
     """The stations' spot feeds and this UAV's claims."""
 
-    def __init__(self, uav_id: str, scenario: Scenario) -> None:
+    def __init__(
+        self,
+        uav_id: str,
+        scenario: Scenario,
+        link_clock: Callable[[], float] = time.monotonic,
+    ) -> None:
         self.uav_id = uav_id
         self.fleet = scenario.fleet
+        self.link_clock = link_clock
         ids = [u.id for u in scenario.fleet.uavs]
         self.place = ids.index(uav_id) if uav_id in ids else len(ids)
+        self._owners = {s.id: spot_owners(s, self.fleet) for s in scenario.site.stations}
+        self.home_station = next(
+            (u.home_station for u in scenario.fleet.uavs if u.id == uav_id), None
+        )
         self._feeds: dict[str, StationSpots] = {}
         self._wanted: tuple[str, int] | None = None
         self._claimed: tuple[str | None, int] | None = None
@@ -60,16 +79,21 @@ class Spots:
             for p in spot_positions(s, self.fleet)
         ]
 
-    def update(self, feed: StationSpots, now_s: float) -> None:
-        """The newest feed of a station, heard at ``now_s`` (an older stamp is ignored)."""
+    def update(self, feed: StationSpots) -> None:
+        """The newest feed of a station (an older stamp is ignored)."""
         known = self._feeds.get(feed.station_id)
         if known is None or feed.stamp_s >= known.stamp_s:
             self._feeds[feed.station_id] = feed
-            self._heard_s[feed.station_id] = now_s
+            self._heard_s[feed.station_id] = self.link_clock()
 
-    def _live(self, station_id: str, now_s: float) -> bool:
+    def _live(self, station_id: str) -> bool:
         heard = self._heard_s.get(station_id)
-        return heard is not None and now_s - heard <= STALE_S
+        return heard is not None and self.link_clock() - heard <= STALE_S
+
+    def cut_off(self) -> bool:
+        """Whether the controllers this UAV heard are all unheard for
+        ``STALE_S`` (never heard any: a site without them, not a cut)."""
+        return bool(self._heard_s) and not any(self._live(s) for s in self._heard_s)
 
     def granted(self, station_id: str) -> int | None:
         """The spot of ``station_id`` granted to this UAV, if any."""
@@ -80,28 +104,29 @@ class Spots:
 
     def has_room(self, station_id: str) -> bool:
         """Whether this UAV can land at ``station_id`` now or after a claim."""
-        return station_id not in self._feeds or self._free(station_id) is not None
+        if not self._live(station_id):
+            return self._unannounced(station_id) is not None
+        return self._free(station_id) is not None
 
-    def cleared(self, station_id: str, now_s: float) -> bool:
+    def cleared(self, station_id: str) -> bool:
         """Whether this UAV may land at ``station_id`` now: granted, or its
-        controller unheard or silent for ``STALE_S``."""
-        return not self._live(station_id, now_s) or self.granted(station_id) is not None
+        controller unheard for ``STALE_S`` and a spot to land on unannounced."""
+        if self.granted(station_id) is not None:
+            return True
+        return not self._live(station_id) and self._unannounced(station_id) is not None
 
     def landing_point(self, station: ChargingStation, now_s: float) -> Point | None:
-        """Where to land at ``station``: the granted spot (or the station, if
-        its controller is unheard); None while a claim waits for its grant."""
+        """Where to land at ``station``: the granted spot, or the spot to land
+        on unannounced while its controller is unheard; None while a claim
+        waits for its grant (or no spot is free)."""
         self._used_s[station.id] = now_s
-        if station.id not in self._feeds:
-            return station.position
         spot = self.granted(station.id)
-        free = self._free(station.id)
-        if spot is None and not self._live(station.id, now_s):
-            spot = free  # cut off from the controller: the spot last seen free
-            if spot is None:
-                return station.position
+        if spot is None and not self._live(station.id):
+            spot = self._unannounced(station.id)
         if spot is not None:
             self._wanted = None
             return spot_positions(station, self.fleet)[spot]
+        free = self._free(station.id)
         self._wanted = (station.id, free) if free is not None else None
         return None
 
@@ -139,12 +164,48 @@ class Spots:
         for ``UNUSED_S`` (or ever: a grant it never asked for)."""
         return now_s - self._used_s.get(station_id, -math.inf) > UNUSED_S
 
+    def _mine(self, station_id: str, i: int) -> bool:
+        """Whether spot ``i`` is this UAV's home spot or a shared one."""
+        owners = self._owners.get(station_id, [])
+        return i >= len(owners) or owners[i] in (None, self.uav_id)
+
+    def _open(self, station_id: str) -> list[int]:
+        """The spots of ``station_id`` this UAV may claim as its last feed
+        shows them (every shared one if none was heard)."""
+        owners = self._owners.get(station_id, [])
+        feed = self._feeds.get(station_id)
+        if feed is None:
+            return [i for i, owner in enumerate(owners) if owner is None]
+        return [
+            i
+            for i, (granted, landed) in enumerate(zip(feed.granted, feed.landed, strict=False))
+            if granted is None
+            and landed in (None, self.uav_id)
+            and (i >= len(owners) or owners[i] in (None, self.uav_id))
+        ]
+
     def _free(self, station_id: str) -> int | None:
-        feed = self._feeds[station_id]
+        """The spot to claim at ``station_id``: the granted one, else this
+        UAV's home spot, else the first free shared one (None: full)."""
         mine = self.granted(station_id)
         if mine is not None:
             return mine
-        for i, (granted, landed) in enumerate(zip(feed.granted, feed.landed, strict=False)):
-            if granted is None and landed in (None, self.uav_id):
-                return i
-        return None
+        if station_id not in self._feeds:
+            return None
+        free = self._open(station_id)
+        home = self._home(station_id)
+        return home if home in free else next(iter(free), None)
+
+    def _unannounced(self, station_id: str) -> int | None:
+        """The spot to land on at ``station_id`` without a grant: the home
+        spot; else a shared one free in the last feed, chosen by this UAV's
+        place in the fleet."""
+        home = self._home(station_id)
+        if home is not None:
+            return home
+        free = self._open(station_id)
+        return free[self.place % len(free)] if free else None
+
+    def _home(self, station_id: str) -> int | None:
+        owners = self._owners.get(station_id, [])
+        return owners.index(self.uav_id) if self.uav_id in owners else None

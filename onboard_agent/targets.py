@@ -206,7 +206,9 @@ def task_station(ctx: Context) -> ChargingStation | None:
 
 def landing_station(ctx: Context) -> ChargingStation | None:
     """Where to land off the plan (battery low, mission over, emergency): the
-    station granted already, else the nearest with room, else the nearest.
+    station granted already; cut off from every spot controller, home (its
+    home spot is the one spot no other UAV can be on) if the energy reaches
+    it with the reserve; else the nearest with room, else the nearest.
     None while the autopilot has no position: "nearest" to the placeholder
     it reports until its first fix (the origin) would claim a spot at a
     station the UAV is not near, a grant that then sticks (issue 21)."""
@@ -217,8 +219,20 @@ def landing_station(ctx: Context) -> ChargingStation | None:
     if not ctx.vehicle.known:
         return None
     here = ctx.vehicle.position
+    home = ctx.surroundings.station(ctx.spots.home_station or "")
+    if home is not None and ctx.spots.cut_off() and _reaches(ctx, home.position):
+        return home
     roomy = [s for s in stations if ctx.spots.has_room(s.id)]
     return ctx.surroundings.nearest_station(here, roomy or stations)
+
+
+def _reaches(ctx: Context, where: Point) -> bool:
+    """Whether the energy left flies the UAV to ``where`` with the reserve
+    (an unknown battery: assumed so)."""
+    vehicle = ctx.vehicle
+    return not vehicle.battery_known or ctx.energy.reaches(
+        vehicle.battery_fraction, vehicle.position, where
+    )
 
 
 def station_target(pick: Callable[[Context], ChargingStation | None]) -> Target:
@@ -232,7 +246,7 @@ def station_target(pick: Callable[[Context], ChargingStation | None]) -> Target:
 
     def cleared(ctx: Context) -> bool:
         station = pick(ctx)
-        return station is None or ctx.spots.cleared(station.id, ctx.clock())
+        return station is None or ctx.spots.cleared(station.id)
 
     def cruise_z(ctx: Context) -> float | None:
         station = pick(ctx)

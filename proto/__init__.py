@@ -97,7 +97,7 @@ from proto.site import (
     Tower,
     Worker,
 )
-from proto.spots import SpotClaim, StationSpots, spot_positions
+from proto.spots import SpotClaim, StationSpots, spot_owners, spot_positions
 from proto.telemetry import (
     AgentState,
     AgentStatus,
@@ -223,5 +223,6 @@ __all__ = [
     "check_id",
     "decode",
     "encode",
+    "spot_owners",
     "spot_positions",
 ]

@@ -1,12 +1,15 @@
 """Landing spots at charging stations, and which UAV may land on which.
 
 A charging station is a row of landing spots along +x, centred on its
-position and ``spot_spacing_m`` apart: one per pad, and one more for each
-UAV beyond that whose home it is (every UAV has a spot at home). At most
-``pads`` of the docked UAVs charge at once. No spot takes two UAVs: the
-station's controller (the simulator plays it) grants each spot to one UAV
-at a time. A UAV claims a free spot with a :class:`SpotClaim` on
-``uav/{id}/spot`` and lands only on a spot that :class:`StationSpots` (on
+position and ``SPOT_SPACING_M`` apart: first a home spot for each UAV whose
+home it is (in fleet order; the simulator starts each UAV on its own),
+then one spot per pad that any UAV may use (at least one spot in all). At
+most ``pads`` of the docked UAVs charge at once. A home spot is its
+owner's alone: so a UAV cut off from every controller can always land at
+home without meeting another. No spot takes two UAVs: the station's
+controller (the simulator plays it) grants each spot to one UAV at a time.
+A UAV claims a free spot with a :class:`SpotClaim` on ``uav/{id}/spot``
+and lands only on a spot that :class:`StationSpots` (on
 ``station/{id}/spots``) shows granted to it; until then it holds clear of
 the station. A grant ends when its UAV takes off from the spot, claims
 another, releases it (``station_id`` None) or has not landed within the
@@ -24,16 +27,16 @@ SPOT_SPACING_M = 2.0
 """Metres between the centres of two neighbouring spots."""
 
 
-def spot_count(station: ChargingStation, fleet: Fleet) -> int:
-    """How many spots ``station`` has: its pads, at least one, and one for
-    every UAV whose home it is."""
-    homes = sum(1 for u in fleet.uavs if u.home_station == station.id)
-    return max(station.pads, 1, homes)
+def spot_owners(station: ChargingStation, fleet: Fleet) -> list[str | None]:
+    """Whose spot each spot of ``station`` is, spot 0 first: the home spots
+    of the UAVs based there, then one shared spot (None) per pad."""
+    homes = [u.id for u in fleet.uavs if u.home_station == station.id]
+    return [*homes, *[None] * max(station.pads, 0 if homes else 1)]
 
 
 def spot_positions(station: ChargingStation, fleet: Fleet) -> list[Point]:
     """Where the spots of ``station`` are, spot 0 first."""
-    n = spot_count(station, fleet)
+    n = len(spot_owners(station, fleet))
     p = station.position
     return [
         Point(x_m=p.x_m + (i - (n - 1) / 2) * SPOT_SPACING_M, y_m=p.y_m, z_m=p.z_m)

@@ -87,6 +87,7 @@ def scenario_from_proto(
                 pads=s.pads,
                 recharge=_recharge(s.recharge),
                 spots=tuple(_vec(p) for p in proto.spot_positions(s, fleet)),
+                owners=tuple(proto.spot_owners(s, fleet)),
             )
             for s in site.stations
         ),

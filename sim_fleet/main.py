@@ -51,8 +51,13 @@ async def serve(
         "simulating %d UAVs at x%g", len(fleet.endpoints), speedup, extra={"ports": fleet.ports}
     )
     tracker = HumanTracker(scenario.site, world, bus)
-    spots = {s.id: s.spot_points for s in fleet.world.scenario.stations}
-    stations = SpotService(SpotControl(spots, world.rules.dock_radius_m), world, bus, keys)
+    sites = fleet.world.scenario.stations
+    control = SpotControl(
+        {s.id: s.spot_points for s in sites},
+        world.rules.dock_radius_m,
+        owners={s.id: s.owners for s in sites},
+    )
+    stations = SpotService(control, world, bus, keys)
     async with asyncio.TaskGroup() as group:
         running = group.create_task(fleet.run())
         poses = group.create_task(tracker.run(pose_hz))

@@ -86,11 +86,19 @@ class StationSpec:
     pads: int = 1
     recharge: RechargeModel | None = None
     spots: tuple[Vec3, ...] = ()  # landing spots (proto.spots); none given: the position
+    owners: tuple[str | None, ...] = ()  # whose home spot each spot is (None: shared)
 
     @property
     def spot_points(self) -> tuple[Vec3, ...]:
         """Where UAVs land at this station."""
         return self.spots or (self.position,)
+
+    def home_spot(self, vehicle_id: str) -> Vec3:
+        """Where ``vehicle_id`` starts: its own spot here, else the first."""
+        points = self.spot_points
+        if vehicle_id in self.owners:
+            return points[self.owners.index(vehicle_id)]
+        return points[0]
 
 
 @dataclass(frozen=True, kw_only=True)

@@ -2,7 +2,8 @@
 and which one may land there (see :mod:`proto.spots`).
 
 ``SpotControl`` is the logic (no clock, no bus): claims are granted first
-come when the spot is neither taken nor granted to another UAV; a grant
+come when the spot is neither taken nor granted to another UAV, nor
+another UAV's home spot (``owners``); a grant
 ends when its UAV takes off from the spot, claims another, gives it up, or
 has not landed within ``grant_ttl_s`` simulated seconds. ``SpotService``
 puts it on the bus: claims in on ``uav/*/spot`` (trusted only from the key
@@ -51,8 +52,10 @@ class SpotControl:
         spots: dict[str, tuple[Vec3, ...]],
         dock_radius_m: float,
         grant_ttl_s: float = GRANT_TTL_S,
+        owners: dict[str, tuple[str | None, ...]] | None = None,
     ) -> None:
         self.spots = spots
+        self.owners = owners or {}
         self.dock_radius_m = dock_radius_m
         self.grant_ttl_s = grant_ttl_s
         self.landed: dict[str, list[str | None]] = {s: [None] * len(p) for s, p in spots.items()}
@@ -66,6 +69,9 @@ class SpotControl:
             return True
         if station_id not in self.spots or not 0 <= spot < len(self.spots[station_id]):
             return False
+        owners = self.owners.get(station_id, ())
+        if spot < len(owners) and owners[spot] not in (None, uav_id):
+            return False  # another UAV's home spot
         grant = self.grants[station_id][spot]
         if grant is not None and grant.uav_id == uav_id:
             return True

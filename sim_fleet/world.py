@@ -47,16 +47,12 @@ class World:
         self._pending_s = 0.0
         self.ground = Ground(scenario.stations, self.rules.dock_radius_m)
         self.vehicles: dict[str, Vehicle] = {}
-        placed: dict[str, int] = {}  # UAVs put on each station's spots so far
         for i, spec in enumerate(scenario.vehicles):
-            spots = scenario.station(spec.home_station).spot_points
-            n = placed[spec.home_station] = placed.get(spec.home_station, 0) + 1
-            home = spots[(n - 1) % len(spots)]
             self.vehicles[spec.id] = Vehicle(
                 spec,
                 scenario.types[spec.type],
                 sysid=first_sysid + i,
-                home=home,
+                home=scenario.station(spec.home_station).home_spot(spec.id),
                 params=params,
                 ground=self.ground.z_at,
             )

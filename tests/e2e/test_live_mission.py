@@ -256,10 +256,11 @@ def _at(sample, uav_id: str):
 
 
 def test_emergency_landings_never_put_two_uavs_on_one_spot(truth):
-    """Three UAVs watch W3, beside C2 (2 pads): kill -9 the ground station.
-    Each agent's emergency lands it at the nearest station with a spot
-    granted to it: two on C2's two spots, the third elsewhere; never two
-    on one spot, never one on top of another."""
+    """Three UAVs watch W3, beside C2 (uav-2's home spot, 2 shared pads):
+    kill -9 the ground station. Each agent's emergency lands it at the
+    nearest station with a spot granted to it: uav-2 on its own, the others
+    on C2's shared spots; never two on one spot, never one on top of
+    another, never on another UAV's home spot."""
     truth.submit(monitor("W3", 3, 200))
     w3 = PAPER.site.worker("W3").position
     truth.until(
@@ -283,7 +284,8 @@ def test_emergency_landings_never_put_two_uavs_on_one_spot(truth):
         assert math.dist(_xyz(v.position), _xyz(spots[station][spot])) < 1.0, v
         where[v.uav_id] = (station, spot)
     assert len(set(where.values())) == 3, where
-    assert sum(1 for station, _ in where.values() if station == "C2") == 2, where
+    assert where["uav-2"] == ("C2", 0), where
+    assert {where["uav-1"], where["uav-3"]} == {("C2", 1), ("C2", 2)}, where
     assert not truth.violations("separation", "off_pad_landing", *UNSAFE)
 
 

@@ -9,11 +9,19 @@ from linecrew.scenarios import load
 from onboard_agent import Agent, AgentConfig
 from proto.geo import Point
 from proto.plan import InspectTask, Plan, Task, Waypoint
+from proto.spots import spot_owners, spot_positions
 from tests.onboard_agent.fakes import FakeAutopilot, FakeClock
 
 SCENARIO = load("paper")
-C1 = SCENARIO.site.station("C1").position
 TICK_S = 0.1
+
+
+def home_spot(uav_id: str) -> Point:
+    """Where the simulator starts ``uav_id``: its own spot at home."""
+    home = next(u.home_station for u in SCENARIO.fleet.uavs if u.id == uav_id)
+    station = SCENARIO.site.station(home)
+    spot = spot_owners(station, SCENARIO.fleet).index(uav_id)
+    return spot_positions(station, SCENARIO.fleet)[spot]
 
 
 def point(x: float, y: float, z: float = 0.0) -> Point:
@@ -39,13 +47,13 @@ class Rig:
         self,
         uav_id: str = "uav-1",
         battery: float = 1.0,
-        position: Point = C1,
+        position: Point | None = None,
         config: AgentConfig | None = None,
         gs_alive: bool = True,
     ) -> None:
         self.clock = FakeClock(1000.0)
         self.wall = FakeClock(1.7e9)
-        self.autopilot = FakeAutopilot(position, battery)
+        self.autopilot = FakeAutopilot(position or home_spot(uav_id), battery)
         self.agent = Agent(
             uav_id,
             SCENARIO,

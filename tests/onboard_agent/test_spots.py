@@ -12,7 +12,7 @@ from proto.spots import StationSpots, spot_positions
 from tests.onboard_agent.helpers import SCENARIO, Rig, plan, point
 
 C3 = SCENARIO.site.station("C3")
-C3_SPOTS = spot_positions(C3, SCENARIO.fleet)  # 2 pads: x 9 and 11
+C3_SPOTS = spot_positions(C3, SCENARIO.fleet)  # uav-3's home spot, then 2 pads: x 8, 10, 12
 
 
 def feed(station: str, granted: list, landed: list | None = None, stamp: float = 1.0):
@@ -24,23 +24,23 @@ def feed(station: str, granted: list, landed: list | None = None, stamp: float =
 def test_a_recharge_claims_a_free_spot_holds_until_granted_then_lands_on_it():
     rig = Rig(battery=0.5, position=point(0, 7, 3))
     spots = rig.agent.ctx.spots
-    spots.update(feed("C3", [None, None], landed=["uav-3", None]), rig.clock())  # spot 0 taken
+    spots.update(feed("C3", [None, None, None], landed=["uav-3", "uav-2", None]))
     task = RechargeTask(task_id="r1", station_id="C3", position=C3.position, until_fraction=0.9)
     rig.agent.offer_plan(plan(task))
-    rig.tick(60)
+    rig.tick(20)  # within STALE_S of the feed
     claim = spots.claim_due(rig.clock())  # what the comms layer sends
-    assert (claim.uav_id, claim.station_id, claim.spot) == ("uav-1", "C3", 1)
+    assert (claim.uav_id, claim.station_id, claim.spot) == ("uav-1", "C3", 2)
     assert spots.claim_due(rig.clock()) is None  # just sent: not again at once
     state = rig.autopilot.state
     hold = spots.hold_point(C3, rig.agent.ctx.config.approach_alt_m)
     assert not state.landed and state.position == hold  # waits above C3, clear of it
     rig.clock.advance(1.0)
     again = spots.claim_due(rig.clock())
-    assert (again.station_id, again.spot) == ("C3", 1)  # repeated until granted
-    spots.update(feed("C3", [None, "uav-1"], landed=["uav-3", None], stamp=2.0), rig.clock())
+    assert (again.station_id, again.spot) == ("C3", 2)  # repeated until granted
+    spots.update(feed("C3", [None, None, "uav-1"], landed=["uav-3", "uav-2", None], stamp=2.0))
     rig.run_until(lambda: rig.autopilot.state.landed)
     landed = rig.autopilot.state.position
-    assert (landed.x_m, landed.y_m) == (C3_SPOTS[1].x_m, C3_SPOTS[1].y_m)
+    assert (landed.x_m, landed.y_m) == (C3_SPOTS[2].x_m, C3_SPOTS[2].y_m)
 
 
 def test_uavs_waiting_for_one_station_hold_at_heights_of_their_own():
@@ -57,18 +57,19 @@ def test_an_emergency_lands_at_the_nearest_station_with_room():
     rig.autopilot.update(flight_state=rig.autopilot.state.flight_state.FLYING, armed=True)
     rig.agent.ground_station("gs", False)
     rig.clock.advance(10.0)
-    spots.update(feed("C3", ["uav-2", None], landed=[None, "uav-3"]), rig.clock())
-    spots.update(feed("C1", [None, None]), rig.clock())
-    spots.update(feed("C2", [None, None]), rig.clock())
+    spots.update(feed("C3", [None, "uav-2", None], landed=[None, None, "uav-3"]))
+    spots.update(feed("C1", [None, None, None]))
+    spots.update(feed("C2", [None, None, None]))
     rig.tick(5)
     claim = spots.claim_due(rig.clock())
     assert claim is not None and claim.station_id == "C2"  # C2 (0, 20) before C1 (-10, 10)
+    assert claim.spot == 1  # spot 0 is uav-2's home
 
 
 def test_a_grant_not_flown_to_is_given_back():
     rig = Rig()
     spots = rig.agent.ctx.spots
-    spots.update(feed("C3", ["uav-1", None]), rig.clock())
+    spots.update(feed("C3", ["uav-1", None]))
     spots.landing_point(C3, rig.clock())
     assert spots.claim_due(rig.clock()) is None  # in use
     rig.clock.advance(6.0)
@@ -82,22 +83,23 @@ def test_a_spot_wanted_then_left_behind_is_not_claimed_on_and_on():
     (a stuck grant drew its emergency landing to the wrong station)."""
     rig = Rig()
     spots = rig.agent.ctx.spots
-    spots.update(feed("C3", [None, None]), rig.clock())
+    spots.update(feed("C3", [None, None]))
     assert spots.landing_point(C3, rig.clock()) is None  # waits for a grant
     assert spots.claim_due(rig.clock()).station_id == "C3"
     rig.clock.advance(6.0)  # no longer asked where to land at C3
     assert spots.claim_due(rig.clock()) is None
-    spots.update(feed("C3", ["uav-1", None], stamp=2.0), rig.clock())  # the late grant
+    spots.update(feed("C3", [None, "uav-1", None], stamp=2.0))  # the late grant
     release = spots.claim_due(rig.clock())
     assert release is not None and release.station_id is None
 
 
-def test_cut_off_from_the_controller_it_lands_on_the_spot_last_seen_free():
+def test_cut_off_from_the_controller_it_lands_on_a_shared_spot_last_seen_free():
     """A partition must never keep a UAV in the air: once the feed is older
-    than STALE_S, the spot the last feed showed free is landed on."""
+    than STALE_S, a shared spot the last feed showed free is landed on,
+    never another UAV's home spot."""
     rig = Rig(battery=0.5, position=point(9, 14, 6))
     spots = rig.agent.ctx.spots
-    spots.update(feed("C3", [None, None], landed=["uav-3", None]), rig.clock())
+    spots.update(feed("C3", [None, None, None], landed=[None, "uav-2", None]))
     task = RechargeTask(task_id="r1", station_id="C3", position=C3.position, until_fraction=0.9)
     rig.agent.offer_plan(plan(task))
     rig.tick(20)
@@ -105,7 +107,40 @@ def test_cut_off_from_the_controller_it_lands_on_the_spot_last_seen_free():
     rig.clock.advance(STALE_S)
     rig.run_until(lambda: rig.autopilot.state.landed)
     landed = rig.autopilot.state.position
-    assert (landed.x_m, landed.y_m) == (C3_SPOTS[1].x_m, C3_SPOTS[1].y_m)
+    assert (landed.x_m, landed.y_m) == (C3_SPOTS[2].x_m, C3_SPOTS[2].y_m)
+
+
+def test_uavs_cut_off_together_land_at_home_each_on_its_own_spot():
+    """Chaos seeds 11, 13, 14: UAVs cut off at once all heard the same last
+    feed and landed on the one spot it showed free. Cut off, each flies to
+    its home spot, which no other UAV is ever granted."""
+    landed = {}
+    for uav in ("uav-1", "uav-3"):
+        rig = Rig(uav_id=uav, position=point(2, 18, 6))  # beside C2, far from home
+        rig.autopilot.update(flight_state=rig.autopilot.state.flight_state.FLYING, armed=True)
+        spots = rig.agent.ctx.spots
+        for station in ("C1", "C2", "C3"):
+            spots.update(feed(station, [None, None, None]))  # the same last feed
+        rig.agent.ground_station("gs", False)
+        rig.clock.advance(STALE_S + 1.0)  # the link's timeout and the feed's at once
+        rig.run_until(lambda r=rig: r.autopilot.state.landed)
+        p = rig.autopilot.state.position
+        landed[uav] = (p.x_m, p.y_m)
+    homes = {
+        u: spot_positions(SCENARIO.site.station(s), SCENARIO.fleet)[0]
+        for u, s in (("uav-1", "C1"), ("uav-3", "C3"))
+    }
+    assert landed == {u: (h.x_m, h.y_m) for u, h in homes.items()}
+
+
+def test_a_station_never_heard_is_landed_on_a_spot_never_between_two():
+    """No controller heard at all (one restarted while cut off): at home the
+    home spot, elsewhere a shared spot, never the station's centre."""
+    spots = Rig(uav_id="uav-2").agent.ctx.spots
+    c2 = SCENARIO.site.station("C2")
+    assert spots.landing_point(c2, 0.0) == spot_positions(c2, SCENARIO.fleet)[0]
+    assert spots.landing_point(C3, 0.0) in C3_SPOTS[1:]
+    assert spots.cleared("C3") and spots.cleared("C2")
 
 
 def test_a_flight_to_a_station_crosses_at_the_uav_s_own_hold_height():
@@ -132,9 +167,9 @@ def test_before_its_position_is_known_a_uav_claims_no_spot_at_another_station():
     rig = Rig(uav_id="uav-2", position=point(0, 0, 0))
     rig.autopilot.update(known=False)
     spots = rig.agent.ctx.spots
-    spots.update(feed("C1", [None, None], landed=["uav-1", None]), rig.clock())
-    spots.update(feed("C2", [None, None], landed=["uav-2", None]), rig.clock())
-    spots.update(feed("C3", [None, None], landed=["uav-3", None]), rig.clock())
+    spots.update(feed("C1", [None, None, None], landed=["uav-1", None, None]))
+    spots.update(feed("C2", [None, None, None], landed=["uav-2", None, None]))
+    spots.update(feed("C3", [None, None, None], landed=["uav-3", None, None]))
     rig.agent.offer_plan(plan(uav_id="uav-2"))  # nothing to do: back to a station
     claims = []
     for _ in range(10):
@@ -146,7 +181,7 @@ def test_before_its_position_is_known_a_uav_claims_no_spot_at_another_station():
     rig.tick()
     claim = spots.claim_due(rig.clock())
     assert claim is not None and (claim.station_id, claim.spot) == ("C2", 0)
-    spots.update(feed("C2", ["uav-2", None], landed=["uav-2", None], stamp=2.0), rig.clock())
+    spots.update(feed("C2", ["uav-2", None, None], landed=["uav-2", None, None], stamp=2.0))
     rig.tick(10)
     assert "takeoff" not in [name for name, _ in rig.autopilot.calls]  # stays on its pad
     assert rig.autopilot.state.landed and rig.autopilot.state.position == home

@@ -37,6 +37,17 @@ def test_a_taken_spot_is_refused_and_the_sitter_may_claim_it():
     assert control.claim("uav-3", "C2", 0, 1.0)
 
 
+def test_a_home_spot_is_granted_to_its_owner_only():
+    """A UAV cut off from the controller lands at home unannounced: no other
+    UAV may be sitting on its home spot then, even while it is away."""
+    control = SpotControl(SPOTS, dock_radius_m=1.0, owners={"C1": ("uav-1", None)})
+    assert not control.claim("uav-2", "C1", 0, 0.0)  # uav-1's home spot
+    assert control.claim("uav-2", "C1", 1, 0.0)  # the shared one
+    assert control.claim("uav-1", "C1", 0, 0.1)
+    assert control.claim("uav-3", "C2", 0, 0.1)  # no owners given: all shared
+    assert control.state("C1").granted == ["uav-1", "uav-2"]
+
+
 def test_a_grant_ends_on_take_off_on_another_claim_on_release_or_when_unused():
     control = SpotControl(SPOTS, dock_radius_m=1.0, grant_ttl_s=60.0)
     control.claim("uav-1", "C1", 0, 0.0)
