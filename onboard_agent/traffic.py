@@ -14,6 +14,8 @@ flies its plan as before.
 
 from __future__ import annotations
 
+from typing import NamedTuple
+
 from proto.geo import Point
 from proto.telemetry import Traffic as TrafficReport
 
@@ -24,6 +26,15 @@ UNHEARD_S = 1.0
 """An entry older than this (five telemetry periods) may have flown on to
 the target it was flying to: it holds that point too (a hung agent's
 autopilot flies on to its last target)."""
+
+
+class Sighting(NamedTuple):
+    """A point another airborne UAV may be at."""
+
+    uav_id: str
+    where: Point
+    unheard: bool  # unheard for ``UNHEARD_S``
+    target: bool  # the target it was flying to, not where it was heard
 
 
 class Traffic:
@@ -40,30 +51,27 @@ class Traffic:
 
     def position(self, uav_id: str, now_s: float) -> Point | None:
         """Where ``uav_id`` was last heard airborne, if the report says so."""
-        return next((where for u, where, _ in self._others(now_s) if u == uav_id), None)
+        return next(
+            (s.where for s in self._others(now_s) if s.uav_id == uav_id and not s.target), None
+        )
 
     def holder(self, point: Point, radius_m: float, now_s: float) -> str | None:
         """Another airborne UAV within ``radius_m`` of ``point``, if any (the
         nearest): where it was heard, or, unheard for ``UNHEARD_S``, the
         target it was flying to."""
-        near = [
-            (where.distance_to(point), uav_id)
-            for uav_id, where, _unheard in self._others(now_s)
-            if where.distance_to(point) < radius_m
-        ]
-        return min(near)[1] if near else None
+        near = [(s.where.distance_to(point), s.uav_id) for s in self._others(now_s)]
+        return min(near)[1] if near and min(near)[0] < radius_m else None
 
     def unheard(self, now_s: float) -> list[Point]:
         """Where other airborne UAVs unheard for ``UNHEARD_S`` may hover: where
         they were heard and the targets they flew to (a route passes them as
         it passes people; one that is heard moves on, and is kept clear of at
         the point it flies to)."""
-        return [where for _uav, where, unheard in self._others(now_s) if unheard]
+        return [s.where for s in self._others(now_s) if s.unheard]
 
-    def _others(self, now_s: float) -> list[tuple[str, Point, bool]]:
-        """(UAV, a point it may be at, whether it is unheard) for the other
-        airborne UAVs of the report: where each was heard, and the target
-        of each unheard one."""
+    def _others(self, now_s: float) -> list[Sighting]:
+        """Where the other airborne UAVs of the report may be: where each
+        was heard, and the target of each unheard one."""
         if self._report is None:
             return []
         since = now_s - self._received_s
@@ -73,7 +81,7 @@ class Traffic:
             if not e.airborne or e.uav_id == self.uav_id or age > STALE_S:
                 continue
             unheard = age > UNHEARD_S
-            out.append((e.uav_id, e.position, unheard))
+            out.append(Sighting(e.uav_id, e.position, unheard, target=False))
             if e.target is not None and unheard:
-                out.append((e.uav_id, e.target, True))
+                out.append(Sighting(e.uav_id, e.target, True, target=True))
         return out
