@@ -9,7 +9,9 @@ are each level or vertical: climb where the UAV is to a height that clears
 every such worker, fly level to above the target, then go straight down to
 it. Targets are themselves placed clear of people (slots beside them,
 drops above them); a worker the target is beside, such as the one a tool
-is dropped to, is passed at the target's height or higher. Flights to a
+is dropped to, is passed at the target's height or higher; one above the
+UAV where it is (another UAV holding higher at a station) is left level,
+never climbed into. Flights to a
 station are legged the same way at the UAV's own height there (see
 :mod:`onboard_agent.spots`), so that UAVs heading for stations at once
 cross at different heights. The spots of a raised station (a roof) are
@@ -53,10 +55,15 @@ def next_leg(
     ]
     if not near and cruise_z is None:
         return target
-    beside_target = [p for p in near if ground_distance(p, target, target) < clear_m]
+    passed = [
+        p
+        for p in near
+        if ground_distance(p, target, target) < clear_m
+        or (ground_distance(p, here, here) < clear_m and p.z_m > here.z_m)
+    ]
     crossing = max(
         [here.z_m, target.z_m, cruise_z or -math.inf]
-        + [p.z_m + clear_m for p in near if p not in beside_target]
+        + [p.z_m + clear_m for p in near if p not in passed]
     )
     if math.hypot(target.x_m - here.x_m, target.y_m - here.y_m) <= TOLERANCE_M:
         return target  # straight up or down to it

@@ -3,9 +3,11 @@
 hovers at: the last line of separation after the plan's own (hold points
 taken in turn, distinct slots, spots) when a plan is stale or a UAV hangs.
 
-A UAV unheard for a while (its agent hung or cut off) may hover where it
-was or at the target it was flying to: a route passes both as it passes
-people (:mod:`onboard_agent.route`).
+A UAV that hovers (heard at the target it flies to: a slot, a hold, a
+waypoint) is in the way of a route across it, and so is one unheard for a
+while (its agent hung or cut off), where it was and at the target it was
+flying to: a route passes those as it passes people
+(:mod:`onboard_agent.route`). A UAV heard on its way is not: it moves on.
 
 Ages are in real seconds (the link clock), whatever the mission's speed-up.
 Without a report (the ground station is away) nothing is known: the agent
@@ -26,6 +28,8 @@ UNHEARD_S = 1.0
 """An entry older than this (five telemetry periods) may have flown on to
 the target it was flying to: it holds that point too (a hung agent's
 autopilot flies on to its last target)."""
+HOVER_M = 1.0
+"""A UAV heard this close to its target hovers there (or is about to)."""
 
 
 class Sighting(NamedTuple):
@@ -35,6 +39,7 @@ class Sighting(NamedTuple):
     where: Point
     unheard: bool  # unheard for ``UNHEARD_S``
     target: bool  # the target it was flying to, not where it was heard
+    hovering: bool = False  # heard within ``HOVER_M`` of its target
 
 
 class Traffic:
@@ -62,12 +67,13 @@ class Traffic:
         near = [(s.where.distance_to(point), s.uav_id) for s in self._others(now_s)]
         return min(near)[1] if near and min(near)[0] < radius_m else None
 
-    def unheard(self, now_s: float) -> list[Point]:
-        """Where other airborne UAVs unheard for ``UNHEARD_S`` may hover: where
-        they were heard and the targets they flew to (a route passes them as
-        it passes people; one that is heard moves on, and is kept clear of at
-        the point it flies to)."""
-        return [s.where for s in self._others(now_s) if s.unheard]
+    def obstacles(self, now_s: float) -> list[Point]:
+        """Where other airborne UAVs hover or may hover: heard at their
+        target, or unheard for ``UNHEARD_S`` (where they were heard and the
+        targets they flew to). Chaos seed 14: a UAV crossing beside a worker
+        at the height that clears people passed 0.96 m from one watching
+        that worker from its slot, at the same height."""
+        return [s.where for s in self._others(now_s) if s.unheard or s.hovering]
 
     def _others(self, now_s: float) -> list[Sighting]:
         """Where the other airborne UAVs of the report may be: where each
@@ -81,7 +87,8 @@ class Traffic:
             if not e.airborne or e.uav_id == self.uav_id or age > STALE_S:
                 continue
             unheard = age > UNHEARD_S
-            out.append(Sighting(e.uav_id, e.position, unheard, target=False))
+            hovering = e.target is not None and e.position.distance_to(e.target) < HOVER_M
+            out.append(Sighting(e.uav_id, e.position, unheard, target=False, hovering=hovering))
             if e.target is not None and unheard:
                 out.append(Sighting(e.uav_id, e.target, True, target=True))
         return out

@@ -164,7 +164,7 @@ class GoNear(AgentBehaviour):
         obstacles = (
             ctx.surroundings.people()
             + ctx.spots.raised_spots(ctx.surroundings.site)
-            + ctx.traffic.unheard(ctx.link_clock())
+            + ctx.traffic.obstacles(ctx.link_clock())
         )
         leg = route.next_leg(vehicle.position, point, obstacles, clear_m, self.target.cruise_z(ctx))
         moved = self._sent is None or self._sent.distance_to(leg) > config.follow_threshold_m

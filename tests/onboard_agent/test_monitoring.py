@@ -292,3 +292,25 @@ def test_a_route_passes_over_a_uav_no_longer_heard_that_hovers_on_its_way():
     climb = last_goto(rig)
     assert (climb.x_m, climb.y_m) == pytest.approx((W2.x_m + 24.0, W2.y_m))  # up first
     assert climb.z_m >= midway.z_m + 2.0
+
+
+def test_a_route_passes_over_a_uav_heard_hovering_at_its_target():
+    """Chaos seed 14: a UAV crossing beside W2 at the height that clears
+    people passed 0.96 m from the UAV watching W2 from its slot. A UAV
+    heard hovering at its target is passed over; one heard on its way to a
+    target elsewhere is not in the way (it moves on)."""
+    rig = Rig(position=point(W2.x_m + 24.0, W2.y_m, W2.z_m + 3.0))
+    rig.autopilot.update(flight_state=rig.autopilot.state.flight_state.FLYING, armed=True)
+    rig.agent.offer_plan(plan(monitor(slot=0, slots=1, duration_s=30.0)))
+    midway = point(W2.x_m + 14.0, W2.y_m, W2.z_m + 3.0)  # on the straight way to the slot
+    away = point(W2.x_m + 14.0, W2.y_m + 20.0, W2.z_m + 3.0)
+    passing = TrafficEntry(uav_id="uav-2", position=midway, airborne=True, target=away)
+    rig.agent.ctx.traffic.update(Traffic(uavs=[passing]), rig.clock())
+    rig.tick(2, arrive=False)
+    assert last_goto(rig).x_m == pytest.approx(W2.x_m + 4.0)  # straight for the slot
+    hovering = msgspec.structs.replace(passing, target=midway)
+    rig.agent.ctx.traffic.update(Traffic(uavs=[hovering]), rig.clock())
+    rig.tick(2, arrive=False)
+    climb = last_goto(rig)
+    assert (climb.x_m, climb.y_m) == pytest.approx((W2.x_m + 24.0, W2.y_m))  # up first
+    assert climb.z_m >= midway.z_m + 2.0

@@ -39,6 +39,16 @@ def test_a_track_over_a_person_climbs_then_crosses_level_then_goes_down():
     assert next_leg(point(-10, 10, 6), low, [W2], CLEAR_M) == low  # straight down
 
 
+def test_a_uav_hovering_right_above_is_left_level_never_climbed_into():
+    """Two UAVs hold beside a station, one 2 m above the other: the lower,
+    granted its spot, leaves level; climbing over the upper one would fly
+    straight into it. One lower than the UAV is still climbed over."""
+    here, spot = point(0, 3, 7), point(0, 0, 3)
+    above, below = point(0, 3, 9), point(0, 3, 5)
+    assert next_leg(here, spot, [above], CLEAR_M) == point(0, 0, 7)
+    assert next_leg(here, spot, [below], CLEAR_M) == point(0, 3, 5 + CLEAR_M)
+
+
 def test_a_target_placed_beside_a_person_is_reached_from_above():
     drop = point(W2.x_m, W2.y_m, W2.z_m + 1.5)  # a tool dropped 1.5 m above W2
     start = point(5, 5, 3)  # lower than the drop: climb first, never at head height
