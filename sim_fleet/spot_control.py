@@ -15,7 +15,6 @@ from __future__ import annotations
 import asyncio
 import dataclasses
 import logging
-import math
 import time
 from collections.abc import Iterable
 
@@ -33,8 +32,9 @@ GRANT_TTL_S = 600.0
 """Simulated seconds a granted UAV has to land on its spot."""
 CLEAR_M = 4.0
 """A UAV that took off from a spot keeps it taken until it is this far from
-it (3-D): one granted it next would otherwise come down onto a UAV still
-climbing out (take-off climbs 3 m straight up)."""
+it horizontally, however high: one granted it next comes down straight
+through the spot's column, onto a UAV still climbing out or hovering above
+(chaos seed 15: 6 m straight above, a 3-D distance had freed the spot)."""
 
 
 @dataclasses.dataclass
@@ -102,7 +102,7 @@ class SpotControl:
                     sitter is None
                     and last is not None
                     and last.airborne
-                    and math.dist(last.position, point) < CLEAR_M
+                    and horizontal_distance(last.position, point) < CLEAR_M
                 )
                 self.landed[station_id][i] = last.id if climbing and last else sitter
                 grant = self.grants[station_id][i]

@@ -99,7 +99,8 @@ def test_a_claim_is_trusted_only_from_the_key_of_the_uav_it_names():
 
 def test_a_spot_stays_taken_until_the_uav_that_took_off_from_it_is_clear():
     """Granted at once, the next UAV would come down onto one still climbing
-    out of the spot (chaos seed 11: uav-1 landing at C2 as uav-2 left it)."""
+    out of the spot (chaos seed 11: uav-1 landing at C2 as uav-2 left it), or
+    still above it however high (seed 15)."""
     control = SpotControl(SPOTS, dock_radius_m=1.0)
     uav2 = Craft("uav-2", (0.0, 20.0, 0.0), airborne=False)
     control.observe([uav2], 0.0)
@@ -107,11 +108,14 @@ def test_a_spot_stays_taken_until_the_uav_that_took_off_from_it_is_clear():
     control.observe([uav2], 1.0)
     assert control.state("C2").landed == ["uav-2"]
     assert not control.claim("uav-1", "C2", 0, 1.0)
-    uav2.position = (3.0, 20.0, 3.0)  # on its way: 4.2 m from the spot
+    uav2.position = (0.3, 20.0, 6.0)  # up at its height, still above the spot
+    control.observe([uav2], 1.5)
+    assert control.state("C2").landed == ["uav-2"]  # chaos seed 15: one came down onto it
+    uav2.position = (4.2, 20.0, 6.0)  # on its way: 4.2 m from the spot's column
     control.observe([uav2], 2.0)
     assert control.state("C2").landed == [None]
     assert control.claim("uav-1", "C2", 0, 2.0)
     control.observe([uav2], 3.0)  # gone for good: not taken again
-    uav2.position = (0.5, 20.0, 3.0)  # even if it passes back over the spot
+    uav2.position = (0.5, 20.0, 6.0)  # even if it passes back over the spot
     control.observe([uav2], 4.0)
     assert control.state("C2").landed == [None]
