@@ -16,7 +16,10 @@ station are legged the same way at the UAV's own height there (see
 :mod:`onboard_agent.spots`), so that UAVs heading for stations at once
 cross at different heights. The spots of a raised station (a roof) are
 cleared the same way: a UAV leaving one climbs clear of the deck before it
-heads for a lower target, and one flying to another crosses above it."""
+heads for a lower target, and one flying to another crosses above it. A
+spot another UAV is granted or sits on is a column up to that UAV's hold
+height (it comes down or climbs out through it): routes cross above it,
+even to a spot beside it."""
 
 from __future__ import annotations
 
@@ -28,6 +31,9 @@ from proto.geo import Point
 TOLERANCE_M = 0.3
 """This close (vertically to the crossing height, horizontally to above the
 target) a leg counts as flown."""
+ABOVE_M = 1.0
+"""An obstacle this close horizontally and higher is right above the UAV:
+climbing over it would fly into it."""
 
 
 def ground_distance(p: Point, a: Point, b: Point) -> float:
@@ -45,25 +51,33 @@ def next_leg(
     people: Iterable[Point],
     clear_m: float,
     cruise_z: float | None = None,
+    columns: Iterable[Point] = (),
 ) -> Point:
     """The point to send the autopilot now on the way from ``here`` to
     ``target``; with ``cruise_z`` the flight is legged anyway and crosses
-    at that height at least (a height of the UAV's own, clear of others)."""
+    at that height at least (a height of the UAV's own, clear of others).
+    ``columns`` are crossed above like ``people``, even beside the target
+    (the spots where other UAVs land and take off)."""
     low = min(here.z_m, target.z_m)
-    near = [
-        p for p in people if ground_distance(p, here, target) < clear_m and low < p.z_m + clear_m
-    ]
-    if not near and cruise_z is None:
+
+    def near(points: Iterable[Point]) -> list[Point]:
+        return [
+            p
+            for p in points
+            if ground_distance(p, here, target) < clear_m and low < p.z_m + clear_m
+        ]
+
+    def above(p: Point) -> bool:
+        return ground_distance(p, here, here) < ABOVE_M and p.z_m > here.z_m
+
+    near_people, near_columns = near(people), near(columns)
+    if not near_people and not near_columns and cruise_z is None:
         return target
-    passed = [
-        p
-        for p in near
-        if ground_distance(p, target, target) < clear_m
-        or (ground_distance(p, here, here) < clear_m and p.z_m > here.z_m)
-    ]
+    beside_target = [p for p in near_people if ground_distance(p, target, target) < clear_m]
+    crossed = [p for p in near_people if p not in beside_target] + near_columns
     crossing = max(
         [here.z_m, target.z_m, cruise_z or -math.inf]
-        + [p.z_m + clear_m for p in near if p not in passed]
+        + [p.z_m + clear_m for p in crossed if not above(p)]
     )
     if math.hypot(target.x_m - here.x_m, target.y_m - here.y_m) <= TOLERANCE_M:
         return target  # straight up or down to it

@@ -43,6 +43,11 @@ STALE_S = 3.0
 link's timeout: a speed-up must not shorten it) no longer gates landing."""
 
 
+def _hold_z(station: ChargingStation, approach_alt_m: float, place: int) -> float:
+    """The height the UAV at ``place`` in the fleet holds at over ``station``."""
+    return station.position.z_m + approach_alt_m + HOLD_STEP_M * (1 + place)
+
+
 class Spots:
     """The stations' spot feeds and this UAV's claims."""
 
@@ -78,6 +83,28 @@ class Spots:
             if s.position.z_m > ground
             for p in spot_positions(s, self.fleet)
         ]
+
+    def busy_columns(self, site: Site, approach_alt_m: float) -> list[Point]:
+        """Above every spot another UAV is granted or sits on (as the last
+        feeds show), at that UAV's hold height: it comes down from there or
+        climbs out through it, so a route crosses the column above it as it
+        passes a person (chaos seed 15: a UAV flying to its station crossed
+        the column another came down through)."""
+        ids = [u.id for u in self.fleet.uavs]
+        out = []
+        for station in site.stations:
+            feed = self._feeds.get(station.id)
+            if feed is None:
+                continue
+            spots = spot_positions(station, self.fleet)
+            for point, granted, landed in zip(spots, feed.granted, feed.landed, strict=False):
+                other = next((u for u in (granted, landed) if u not in (None, self.uav_id)), None)
+                if other is None:
+                    continue
+                place = ids.index(other) if other in ids else len(ids)
+                z = _hold_z(station, approach_alt_m, place)
+                out.append(Point(x_m=point.x_m, y_m=point.y_m, z_m=z))
+        return out
 
     def update(self, feed: StationSpots) -> None:
         """The newest feed of a station (an older stamp is ignored)."""
@@ -135,9 +162,7 @@ class Spots:
         spots (``HOLD_ASIDE_M``), at a height of its own."""
         p = station.position
         return Point(
-            x_m=p.x_m,
-            y_m=p.y_m + HOLD_ASIDE_M,
-            z_m=p.z_m + approach_alt_m + HOLD_STEP_M * (1 + self.place),
+            x_m=p.x_m, y_m=p.y_m + HOLD_ASIDE_M, z_m=_hold_z(station, approach_alt_m, self.place)
         )
 
     def claim_due(self, now_s: float) -> SpotClaim | None:

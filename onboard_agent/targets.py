@@ -238,7 +238,10 @@ def _reaches(ctx: Context, where: Point) -> bool:
 def station_target(pick: Callable[[Context], ChargingStation | None]) -> Target:
     """Above a landing spot at the station ``pick`` names: near once over
     the spot granted to this UAV (or no controller gates it), flown to at
-    the UAV's own hold height there."""
+    the UAV's own hold height there. The point above the spot is kept clear
+    of like any other (a UAV hovering 1 m from it, at an inspection
+    waypoint, chaos seed 15); the hold point is not (spots keep UAVs
+    waiting apart, at heights of their own)."""
 
     def locate(ctx: Context) -> Point | None:
         station = pick(ctx)
@@ -257,7 +260,10 @@ def station_target(pick: Callable[[Context], ChargingStation | None]) -> Target:
     def radius(ctx: Context) -> float:
         return ctx.config.near_station_m
 
-    # a spot is granted to one UAV at a time, and each UAV holds at a height of its own
+    def landing(ctx: Context) -> bool:
+        station = pick(ctx)
+        return station is not None and ctx.spots.cleared(station.id)
+
     return Target(
         "Charging Station",
         locate,
@@ -265,7 +271,7 @@ def station_target(pick: Callable[[Context], ChargingStation | None]) -> Target:
         True,
         cleared=cleared,
         cruise_z=cruise_z,
-        keep_clear=lambda _ctx: False,
+        keep_clear=landing,
     )
 
 

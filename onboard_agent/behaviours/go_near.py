@@ -166,7 +166,9 @@ class GoNear(AgentBehaviour):
             + ctx.spots.raised_spots(ctx.surroundings.site)
             + ctx.traffic.obstacles(ctx.link_clock())
         )
-        leg = route.next_leg(vehicle.position, point, obstacles, clear_m, self.target.cruise_z(ctx))
+        columns = ctx.spots.busy_columns(ctx.surroundings.site, config.approach_alt_m)
+        cruise_z = self.target.cruise_z(ctx)
+        leg = route.next_leg(vehicle.position, point, obstacles, clear_m, cruise_z, columns)
         moved = self._sent is None or self._sent.distance_to(leg) > config.follow_threshold_m
         if moved or now - self._sent_at >= config.goto_resend_s:
             ctx.goto(leg)

@@ -9,6 +9,7 @@ import math
 from onboard_agent.spots import STALE_S
 from proto.plan import RechargeTask
 from proto.spots import StationSpots, spot_positions
+from proto.telemetry import Traffic, TrafficEntry
 from tests.onboard_agent.helpers import SCENARIO, Rig, plan, point
 
 C3 = SCENARIO.site.station("C3")
@@ -195,3 +196,51 @@ def test_hold_points_stand_clear_of_the_column_above_every_spot():
     separation = SCENARIO.site.safety.separation_m
     for spot in C3_SPOTS:
         assert math.hypot(hold.x_m - spot.x_m, hold.y_m - spot.y_m) >= separation + 2.0
+
+
+def test_a_route_to_a_station_crosses_above_the_column_of_a_spot_in_use():
+    """Chaos seed 15: uav-1, on its way to C2's shared spot, crossed uav-2's
+    home spot at 5.6 m as uav-2 came down onto it from its hold height. A
+    spot another UAV is granted (or sits on) is a column up to that UAV's
+    hold height: the route climbs above it first."""
+    c2 = SCENARIO.site.station("C2")
+    spots_c2 = spot_positions(c2, SCENARIO.fleet)
+    rig = Rig(battery=0.5, position=point(spots_c2[0].x_m - 4.0, c2.position.y_m, 5.0))
+    rig.autopilot.update(flight_state=rig.autopilot.state.flight_state.FLYING, armed=True)
+    spots = rig.agent.ctx.spots
+    spots.update(feed("C2", ["uav-2", "uav-1", None]))  # uav-2 comes home, spot 1 is ours
+    task = RechargeTask(task_id="r1", station_id="C2", position=c2.position, until_fraction=0.9)
+    rig.agent.offer_plan(plan(task))
+    rig.tick(2, arrive=False)
+    climb = [arg for name, arg in rig.autopilot.calls if name == "goto"][-1]
+    uav2_hold = spots.hold_point(c2, rig.agent.ctx.config.approach_alt_m)  # uav-1's own
+    assert (climb.x_m, climb.y_m) == (spots_c2[0].x_m - 4.0, c2.position.y_m)  # up where it is
+    assert climb.z_m >= uav2_hold.z_m + 2.0 + 2.0  # above uav-2's hold height (2 m higher)
+    spots.update(feed("C2", [None, "uav-1", None], stamp=2.0))  # uav-2 gone elsewhere
+    rig.tick(2, arrive=False)
+    level = [arg for name, arg in rig.autopilot.calls if name == "goto"][-1]
+    assert level.z_m == uav2_hold.z_m  # across at its own hold height again
+
+
+def test_the_point_above_a_granted_spot_is_flown_to_once_no_uav_hovers_by_it():
+    """Chaos seed 15: uav-1 came down to its spot at C2 1 m from uav-2,
+    hovering at an inspection waypoint beside it. The point above a granted
+    spot is kept clear of like any other; the hold point is not."""
+    c2 = SCENARIO.site.station("C2")
+    above = spot_positions(c2, SCENARIO.fleet)[1]
+    rig = Rig(battery=0.5, position=point(above.x_m, above.y_m - 8.0, 5.0))
+    rig.autopilot.update(flight_state=rig.autopilot.state.flight_state.FLYING, armed=True)
+    spots = rig.agent.ctx.spots
+    spots.update(feed("C2", [None, "uav-1", None]))
+    waypoint = point(above.x_m, above.y_m + 1.0, 3.0)  # uav-2 inspects there
+    hovering = TrafficEntry(uav_id="uav-2", position=waypoint, airborne=True, target=waypoint)
+    rig.agent.ctx.traffic.update(Traffic(uavs=[hovering]), rig.clock())
+    task = RechargeTask(task_id="r1", station_id="C2", position=c2.position, until_fraction=0.9)
+    rig.agent.offer_plan(plan(task))
+    start = rig.autopilot.state.position
+    rig.tick(5)
+    assert rig.autopilot.state.position == start  # holds off where it is
+    rig.agent.ctx.traffic.update(Traffic(uavs=[]), rig.clock())  # uav-2 moved on
+    rig.run_until(lambda: rig.autopilot.state.landed)
+    landed = rig.autopilot.state.position
+    assert (landed.x_m, landed.y_m) == (above.x_m, above.y_m)
