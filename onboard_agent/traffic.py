@@ -3,11 +3,11 @@
 hovers at: the last line of separation after the plan's own (hold points
 taken in turn, distinct slots, spots) when a plan is stale or a UAV hangs.
 
-A UAV that hovers (heard at the target it flies to: a slot, a hold, a
-waypoint) is in the way of a route across it, and so is one unheard for a
-while (its agent hung or cut off), where it was and at the target it was
-flying to: a route passes those as it passes people
-(:mod:`onboard_agent.route`). A UAV heard on its way is not: it moves on.
+A route passes as it passes people (:mod:`onboard_agent.route`) the
+points other UAVs hover at or are about to: the target each flies to (a
+slot, a hold, a waypoint, the next leg), where each that hovers there is,
+and where each unheard for a while (its agent hung or cut off) was last
+heard. Where a UAV heard on its way is now is not in the way: it moves on.
 
 Ages are in real seconds (the link clock), whatever the mission's speed-up.
 Without a report (the ground station is away) nothing is known: the agent
@@ -64,20 +64,24 @@ class Traffic:
         """Another airborne UAV within ``radius_m`` of ``point``, if any (the
         nearest): where it was heard, or, unheard for ``UNHEARD_S``, the
         target it was flying to."""
-        near = [(s.where.distance_to(point), s.uav_id) for s in self._others(now_s)]
+        near = [
+            (s.where.distance_to(point), s.uav_id)
+            for s in self._others(now_s)
+            if s.unheard or not s.target
+        ]
         return min(near)[1] if near and min(near)[0] < radius_m else None
 
     def obstacles(self, now_s: float) -> list[Point]:
-        """Where other airborne UAVs hover or may hover: heard at their
-        target, or unheard for ``UNHEARD_S`` (where they were heard and the
-        targets they flew to). Chaos seed 14: a UAV crossing beside a worker
-        at the height that clears people passed 0.96 m from one watching
-        that worker from its slot, at the same height."""
-        return [s.where for s in self._others(now_s) if s.unheard or s.hovering]
+        """Where other airborne UAVs hover or are about to: heard at their
+        target, the targets they fly to, and where those unheard for
+        ``UNHEARD_S`` were heard. Chaos seeds 14 and 17: a UAV crossing
+        beside a worker at the height that clears people passed 0.92 m
+        from one arriving at (or watching from) its slot beside that worker."""
+        return [s.where for s in self._others(now_s) if s.target or s.unheard or s.hovering]
 
     def _others(self, now_s: float) -> list[Sighting]:
         """Where the other airborne UAVs of the report may be: where each
-        was heard, and the target of each unheard one."""
+        was heard, and the target each was flying to."""
         if self._report is None:
             return []
         since = now_s - self._received_s
@@ -89,6 +93,6 @@ class Traffic:
             unheard = age > UNHEARD_S
             hovering = e.target is not None and e.position.distance_to(e.target) < HOVER_M
             out.append(Sighting(e.uav_id, e.position, unheard, target=False, hovering=hovering))
-            if e.target is not None and unheard:
-                out.append(Sighting(e.uav_id, e.target, True, target=True))
+            if e.target is not None:
+                out.append(Sighting(e.uav_id, e.target, unheard, target=True))
         return out

@@ -314,3 +314,20 @@ def test_a_route_passes_over_a_uav_heard_hovering_at_its_target():
     climb = last_goto(rig)
     assert (climb.x_m, climb.y_m) == pytest.approx((W2.x_m + 24.0, W2.y_m))  # up first
     assert climb.z_m >= midway.z_m + 2.0
+
+
+def test_a_route_passes_over_the_point_another_uav_is_flying_to():
+    """Chaos seed 17: a UAV crossing beside W2 at the height that clears
+    people met the one arriving at W2's slot, both in motion. The target
+    another UAV flies to is passed over as if it hovered there already."""
+    rig = Rig(position=point(W2.x_m + 24.0, W2.y_m, W2.z_m + 3.0))
+    rig.autopilot.update(flight_state=rig.autopilot.state.flight_state.FLYING, armed=True)
+    rig.agent.offer_plan(plan(monitor(slot=0, slots=1, duration_s=30.0)))
+    midway = point(W2.x_m + 14.0, W2.y_m, W2.z_m + 3.0)  # on the straight way to the slot
+    far = point(W2.x_m + 14.0, W2.y_m + 20.0, W2.z_m + 3.0)
+    arriving = TrafficEntry(uav_id="uav-2", position=far, airborne=True, target=midway)
+    rig.agent.ctx.traffic.update(Traffic(uavs=[arriving]), rig.clock())
+    rig.tick(2, arrive=False)
+    climb = last_goto(rig)
+    assert (climb.x_m, climb.y_m) == pytest.approx((W2.x_m + 24.0, W2.y_m))  # up first
+    assert climb.z_m >= midway.z_m + 2.0
