@@ -274,60 +274,35 @@ def test_a_uav_no_longer_heard_is_kept_clear_of_at_the_target_it_flew_to():
     assert last_goto(rig).distance_to(slot) > 2.0
 
 
-def test_a_route_passes_over_a_uav_no_longer_heard_that_hovers_on_its_way():
-    """A hung agent's UAV hovers where it was (chaos seed 12: another UAV
-    flew past it, closer than the separation): the route climbs over it,
-    as over a person; one just heard is not in the way (it moves on)."""
+MIDWAY = point(W2.x_m + 14.0, W2.y_m, W2.z_m + 3.0)  # on the straight way to W2's slot
+FAR = point(W2.x_m + 14.0, W2.y_m + 20.0, W2.z_m + 3.0)
+
+
+@pytest.mark.parametrize(
+    ("entry", "climbs"),
+    [
+        ({"position": MIDWAY, "age_s": 0.2}, False),  # heard: it moves on
+        ({"position": MIDWAY, "age_s": 5.0}, True),  # unheard, hovers there (seed 12)
+        ({"position": MIDWAY, "target": FAR}, False),  # heard passing, bound elsewhere
+        ({"position": MIDWAY, "target": MIDWAY}, True),  # heard hovering there (seed 14)
+        ({"position": FAR, "target": MIDWAY}, True),  # heard flying there (seed 17)
+    ],
+)
+def test_a_route_passes_over_where_another_uav_hovers_or_is_about_to(entry, climbs):
+    """A UAV crossing beside W2 passed another closer than the separation:
+    one whose agent hung (chaos seed 12), one watching W2 from its slot
+    (seed 14), one arriving there (seed 17). The route climbs over where
+    another UAV hovers or flies to, as over a person; where one heard on
+    its way to elsewhere is now is not in the way."""
     rig = Rig(position=point(W2.x_m + 24.0, W2.y_m, W2.z_m + 3.0))
     rig.autopilot.update(flight_state=rig.autopilot.state.flight_state.FLYING, armed=True)
     rig.agent.offer_plan(plan(monitor(slot=0, slots=1, duration_s=30.0)))
-    midway = point(W2.x_m + 14.0, W2.y_m, W2.z_m + 3.0)  # on the straight way to the slot
-    heard = TrafficEntry(uav_id="uav-2", position=midway, airborne=True, age_s=0.2)
-    rig.agent.ctx.traffic.update(Traffic(uavs=[heard]), rig.clock())
+    other = TrafficEntry(uav_id="uav-2", airborne=True, **entry)
+    rig.agent.ctx.traffic.update(Traffic(uavs=[other]), rig.clock())
     rig.tick(2, arrive=False)
-    assert last_goto(rig).x_m == pytest.approx(W2.x_m + 4.0)  # straight for the slot
-    unheard = msgspec.structs.replace(heard, age_s=5.0)
-    rig.agent.ctx.traffic.update(Traffic(uavs=[unheard]), rig.clock())
-    rig.tick(2, arrive=False)
-    climb = last_goto(rig)
-    assert (climb.x_m, climb.y_m) == pytest.approx((W2.x_m + 24.0, W2.y_m))  # up first
-    assert climb.z_m >= midway.z_m + 2.0
-
-
-def test_a_route_passes_over_a_uav_heard_hovering_at_its_target():
-    """Chaos seed 14: a UAV crossing beside W2 at the height that clears
-    people passed 0.96 m from the UAV watching W2 from its slot. A UAV
-    heard hovering at its target is passed over; one heard on its way to a
-    target elsewhere is not in the way (it moves on)."""
-    rig = Rig(position=point(W2.x_m + 24.0, W2.y_m, W2.z_m + 3.0))
-    rig.autopilot.update(flight_state=rig.autopilot.state.flight_state.FLYING, armed=True)
-    rig.agent.offer_plan(plan(monitor(slot=0, slots=1, duration_s=30.0)))
-    midway = point(W2.x_m + 14.0, W2.y_m, W2.z_m + 3.0)  # on the straight way to the slot
-    away = point(W2.x_m + 14.0, W2.y_m + 20.0, W2.z_m + 3.0)
-    passing = TrafficEntry(uav_id="uav-2", position=midway, airborne=True, target=away)
-    rig.agent.ctx.traffic.update(Traffic(uavs=[passing]), rig.clock())
-    rig.tick(2, arrive=False)
-    assert last_goto(rig).x_m == pytest.approx(W2.x_m + 4.0)  # straight for the slot
-    hovering = msgspec.structs.replace(passing, target=midway)
-    rig.agent.ctx.traffic.update(Traffic(uavs=[hovering]), rig.clock())
-    rig.tick(2, arrive=False)
-    climb = last_goto(rig)
-    assert (climb.x_m, climb.y_m) == pytest.approx((W2.x_m + 24.0, W2.y_m))  # up first
-    assert climb.z_m >= midway.z_m + 2.0
-
-
-def test_a_route_passes_over_the_point_another_uav_is_flying_to():
-    """Chaos seed 17: a UAV crossing beside W2 at the height that clears
-    people met the one arriving at W2's slot, both in motion. The target
-    another UAV flies to is passed over as if it hovered there already."""
-    rig = Rig(position=point(W2.x_m + 24.0, W2.y_m, W2.z_m + 3.0))
-    rig.autopilot.update(flight_state=rig.autopilot.state.flight_state.FLYING, armed=True)
-    rig.agent.offer_plan(plan(monitor(slot=0, slots=1, duration_s=30.0)))
-    midway = point(W2.x_m + 14.0, W2.y_m, W2.z_m + 3.0)  # on the straight way to the slot
-    far = point(W2.x_m + 14.0, W2.y_m + 20.0, W2.z_m + 3.0)
-    arriving = TrafficEntry(uav_id="uav-2", position=far, airborne=True, target=midway)
-    rig.agent.ctx.traffic.update(Traffic(uavs=[arriving]), rig.clock())
-    rig.tick(2, arrive=False)
-    climb = last_goto(rig)
-    assert (climb.x_m, climb.y_m) == pytest.approx((W2.x_m + 24.0, W2.y_m))  # up first
-    assert climb.z_m >= midway.z_m + 2.0
+    leg = last_goto(rig)
+    if climbs:
+        assert (leg.x_m, leg.y_m) == pytest.approx((W2.x_m + 24.0, W2.y_m))  # up first
+        assert leg.z_m >= MIDWAY.z_m + 2.0
+    else:
+        assert leg.x_m == pytest.approx(W2.x_m + 4.0)  # straight for the slot
