@@ -60,12 +60,15 @@ class ActionBook:
         reason: str,
     ) -> None:
         """Save ``after`` over ``before`` in one write, in the state ``event``
-        leads to (if any); a change of state is announced once saved."""
+        leads to (if any); a change of state is announced once saved. An
+        event that keeps the state still leaves its reason on the record
+        (why an accepted action waits: ``no_capable_uav`` when the only UAVs
+        able to do it crashed)."""
         state = after.state if event is None else next_state(before.state, event)
         changed = state != before.state
-        if changed:
+        if changed or (event is not None and reason != before.reason):
             after = msgspec.structs.replace(after, state=state, reason=reason)
-        elif after == before:
+        if not changed and after == before:
             return
         self.save(after, before.state, reason)
         if changed:

@@ -396,11 +396,13 @@ class MissionManager:
 
     def _apply(self, outcome: ReplanOutcome, records: list[ActionRecord]) -> None:
         """Move each action on as the plan says; an action whose state the
-        event leaves alone (as of the replan's inputs) is not read again."""
-        before = {r.action_id: r.state for r in records}
+        event leaves alone (as of the replan's inputs) is not read again,
+        unless the plan leaves it waiting (the record says why)."""
+        before = {r.action_id: (r.state, r.reason) for r in records}
         for action_id, (event, reason_text) in outcome.action_events.items():
-            state = before.get(action_id)
-            if state is not None and TRANSITIONS.get((state, event)) == state:
+            state, reason = before.get(action_id, (None, ""))
+            kept = state is not None and TRANSITIONS.get((state, event)) == state
+            if kept and (event is not ActionEvent.UNPLACED or reason == reason_text):
                 continue
             record = self.store.action(action_id)
             if record is not None and record.state not in TERMINAL:

@@ -19,8 +19,10 @@
   ``monitored_s`` times its UAVs) exceeds the seconds the simulator saw
   UAVs hover watching that worker, beyond ``CREDIT_TOLERANCE`` and
   ``CREDIT_SLACK_S`` per UAV of each action (settling at the slot).
-- ``unfinished``: at the end every accepted action has completed or failed;
-  ``failed_without_reason``: a failed action carries a reason.
+- ``unfinished``: at the end every accepted action has completed or failed,
+  unless it waits for a capable UAV (its reason ``no_capable_uav``) and a
+  UAV crashed after a fault injected on it (excused: a crashed UAV needs a
+  person); ``failed_without_reason``: a failed action carries a reason.
 
 The checker only consumes samples (plain dicts from the REST gateway and the
 simulator's :class:`proto.SimState`); it does no I/O and reads no clock.
@@ -72,6 +74,7 @@ class Checker:
         self._overcredited: set[str] = set()  # workers already reported
         self._watched: dict[tuple[str, str], float] = {}  # (worker, uav) -> watched s, last sample
         self._together: dict[tuple[str, str, str], float] = {}  # (worker, uav, uav) -> since sim s
+        self._crashed: set[str] = set()  # UAVs the simulator saw crashed after a fault
 
     # -- inputs ------------------------------------------------------------------
 
@@ -117,7 +120,12 @@ class Checker:
             if record is None:
                 continue  # already reported as lost
             self.checks["unfinished"] += 1
-            if record["state"] not in TERMINAL:
+            if record["state"] not in TERMINAL and self._waits_for_crashed(record):
+                self.excused.append(
+                    f"t={at_s:.1f} s {action_id} still {record['state']}, waiting for a capable"
+                    f" UAV: excused by the crash of {', '.join(sorted(self._crashed))}"
+                )
+            elif record["state"] not in TERMINAL:
                 self._violate(
                     at_s,
                     "unfinished",
@@ -128,6 +136,11 @@ class Checker:
                 self.checks["failed_without_reason"] += 1
                 if not record.get("reason"):
                     self._violate(at_s, "failed_without_reason", action_id)
+
+    def _waits_for_crashed(self, record: dict[str, Any]) -> bool:
+        """Whether ``record`` waits for a capable UAV while one a fault was
+        injected on lies crashed."""
+        return "no_capable_uav" in (record.get("reason") or "") and bool(self._crashed)
 
     # -- checks ------------------------------------------------------------------
 
@@ -186,6 +199,8 @@ class Checker:
         floor = self.reserve_fraction - self.tolerance
         for vehicle in truth.vehicles:
             uav = vehicle.uav_id
+            if vehicle.state == "crashed" and self.excuses.get(uav):
+                self._crashed.add(uav)
             if vehicle.battery_fraction >= floor or vehicle.state == "crashed":
                 self._below.discard(uav)
                 continue

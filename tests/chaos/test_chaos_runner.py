@@ -20,7 +20,7 @@ from linecrew.chaos.schedule import DISRUPTIONS
 from linecrew.chaos.timeline import Timeline
 from linecrew.process import Shutdown
 from linecrew.scenarios import load
-from proto import Point, SafetyViolation, SimState, WatchRecord
+from proto import Point, SafetyViolation, SimState, VehicleTruth, WatchRecord
 
 chaos_main = importlib.import_module("linecrew.chaos.main")  # the package exports main()
 
@@ -83,6 +83,30 @@ def test_the_checker_flags_what_the_simulator_saw_as_unsafe_once_each():
         ("unsafe", "separation uav-1 uav-2 at sim 3.0 s")
     ]
     assert len(checker.excused) == 1 and "battery fault" in checker.excused[0]
+
+
+def test_an_action_left_waiting_by_a_crash_is_excused_any_other_unfinished_is_not():
+    """Chaos seed 16: a delivery asked for after a motor fault crashed the
+    only UAV with a gripper waits for a capable UAV: a person must act."""
+    waiting = {"action_id": "a1", "state": "accepted", "reason": "no_capable_uav"}
+    crashed = VehicleTruth(
+        uav_id="uav-1",
+        position=Point(x_m=0, y_m=0),
+        battery_fraction=0.5,
+        state="crashed",
+        armed=False,
+    )
+    for fault, violations in (("motor fault", 0), (None, 1)):
+        checker = Checker(reserve_fraction=0.2)
+        if fault:
+            checker.excuse("uav-1", fault)
+        checker.accepted("a1", 0.0)
+        checker.sample(
+            1.0, None, None, None, SimState(sim_time_s=1.0, speedup=1.0, vehicles=[crashed])
+        )
+        checker.finish(2.0, [waiting])
+        assert len(checker.violations) == violations, checker.violations
+        assert len(checker.excused) == 1 - violations
 
 
 def test_a_short_seeded_run_reports_zero_violations(tmp_path, capsys):

@@ -212,3 +212,16 @@ def test_an_improvement_restarting_from_scratch_yields_to_a_trigger_mid_construc
     assert calls[0] == 4
     assert live._starts == starts  # the same start is tried on the next attempt
     assert live.session.plan() == before
+
+
+def test_an_action_no_uav_in_service_can_do_waits_and_says_why(tmp_path):
+    """Chaos seed 16: a delivery asked for after the only UAV with a gripper
+    crashed stayed "accepted" with no word of why. It waits, saying so, and
+    is planned once that UAV is back."""
+    gs = Harness(str(tmp_path / "gs.db"))
+    gs.bring_up("uav-2", "uav-3")  # uav-1, the only gripper, is not in service
+    record = gs.submit("deliver-wrench")
+    assert record.state == "accepted" and "no_capable_uav" in record.reason, record
+    gs.bring_up("uav-1")
+    gs.advance(1.0)
+    assert gs.manager.book.record("deliver-wrench").state == "planned"
