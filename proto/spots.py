@@ -1,9 +1,10 @@
 """Landing spots at charging stations, and which UAV may land on which.
 
-A charging station is a row of landing spots along +x, centred on its
-position and ``SPOT_SPACING_M`` apart: first a home spot for each UAV whose
-home it is (in fleet order; the simulator starts each UAV on its own),
-then one spot per pad that any UAV may use (at least one spot in all). At
+A charging station is a row of landing spots along +x, ``SPOT_SPACING_M``
+apart: one spot per pad that any UAV may use, centred on its position, and
+a home spot for each UAV whose home it is (in fleet order; the simulator
+starts each UAV on its own), on along the row (at least one spot in all;
+spot indices list the home spots first). At
 most ``pads`` of the docked UAVs charge at once. A home spot is its
 owner's alone: so a UAV cut off from every controller can always land at
 home without meeting another. No spot takes two UAVs: the station's
@@ -35,13 +36,18 @@ def spot_owners(station: ChargingStation, fleet: Fleet) -> list[str | None]:
 
 
 def spot_positions(station: ChargingStation, fleet: Fleet) -> list[Point]:
-    """Where the spots of ``station`` are, spot 0 first."""
-    n = len(spot_owners(station, fleet))
+    """Where the spots of ``station`` are, spot 0 first: the shared spots
+    (its pads) centred on its position, the home spots on after them along
+    +x (centred themselves if there is no pad). A point the site puts just
+    beside the station (the paper's inspection waypoint 1 m from C2) keeps
+    its distance from the pads whatever the fleet."""
+    owners = spot_owners(station, fleet)
+    shared = owners.count(None)
+    homes = len(owners) - shared
+    first = -(shared - 1) / 2 if shared else -(homes - 1) / 2
+    slots = [first + shared + i for i in range(homes)] + [first + i for i in range(shared)]
     p = station.position
-    return [
-        Point(x_m=p.x_m + (i - (n - 1) / 2) * SPOT_SPACING_M, y_m=p.y_m, z_m=p.z_m)
-        for i in range(n)
-    ]
+    return [Point(x_m=p.x_m + slot * SPOT_SPACING_M, y_m=p.y_m, z_m=p.z_m) for slot in slots]
 
 
 class SpotClaim(Message, frozen=True, kw_only=True):

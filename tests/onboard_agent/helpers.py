@@ -16,6 +16,17 @@ SCENARIO = load("paper")
 TICK_S = 0.1
 
 
+def on_a_spot(where: Point, station_id: str, uav_id: str = "uav-1") -> bool:
+    """Whether ``where`` is above a spot of ``station_id`` that ``uav_id``
+    may use: a shared one, or its own home spot."""
+    station = SCENARIO.site.station(station_id)
+    points, owners = spot_positions(station, SCENARIO.fleet), spot_owners(station, SCENARIO.fleet)
+    spots = zip(points, owners, strict=True)
+    return any(
+        (where.x_m, where.y_m) == (p.x_m, p.y_m) for p, owner in spots if owner in (None, uav_id)
+    )
+
+
 def home_spot(uav_id: str) -> Point:
     """Where the simulator starts ``uav_id``: its own spot at home."""
     home = next(u.home_station for u in SCENARIO.fleet.uavs if u.id == uav_id)

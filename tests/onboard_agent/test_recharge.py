@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from proto.plan import GoHomeTask, RechargeTask, WaitTask
 from proto.telemetry import FlightState, OutcomeResult
-from tests.onboard_agent.helpers import SCENARIO, Rig, plan, point
+from tests.onboard_agent.helpers import SCENARIO, Rig, on_a_spot, plan, point
 
 C3 = SCENARIO.site.station("C3").position
 H = SCENARIO.site.station("C2").position
@@ -16,7 +16,7 @@ def test_planned_recharge_lands_on_its_station_and_waits_for_the_fraction():
     rig.agent.offer_plan(plan(task))
     rig.run_until(lambda: rig.leaf() == "Recharge")
     state = rig.autopilot.state
-    assert state.landed and (state.position.x_m, state.position.y_m) == (C3.x_m, C3.y_m)
+    assert state.landed and on_a_spot(state.position, "C3")
     assert rig.agent.status().state == "recharging"
     rig.tick(50)
     assert rig.mission.head is task
@@ -42,5 +42,5 @@ def test_go_home_flies_to_the_station_and_lands():
     rig.agent.offer_plan(plan(GoHomeTask(task_id="h1", station_id="C2", position=H)))
     rig.run_until(lambda: rig.mission.head is None)
     state = rig.autopilot.state
-    assert state.landed and (state.position.x_m, state.position.y_m) == (H.x_m, H.y_m)
+    assert state.landed and on_a_spot(state.position, "C2")
     assert [o.result for o in rig.outcomes()] == [OutcomeResult.COMPLETED]

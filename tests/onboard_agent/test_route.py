@@ -14,7 +14,7 @@ from onboard_agent import AgentConfig
 from onboard_agent.route import ground_distance, next_leg
 from onboard_agent.spots import Spots
 from proto.telemetry import FlightState
-from tests.onboard_agent.helpers import SCENARIO, Rig, point
+from tests.onboard_agent.helpers import SCENARIO, Rig, on_a_spot, point
 
 W2 = SCENARIO.site.worker("W2").position  # (-5, 15, 3)
 CLEARANCE_M = SCENARIO.site.safety.people_clearance_m
@@ -95,11 +95,11 @@ def test_the_flight_to_a_station_from_beside_a_worker_keeps_the_clearance(start,
             path.append(here)
         return rig.autopilot.state.landed
 
-    station = rig.agent.ctx.surroundings.nearest_station(start).position
-    assert (ground_distance(W3, start, station) < CLEARANCE_M) == crosses
+    station = rig.agent.ctx.surroundings.nearest_station(start)
+    assert (ground_distance(W3, start, station.position) < CLEARANCE_M) == crosses
     rig.run_until(flown, max_ticks=400)
     assert min(_closest(path, w) for w in (W2, W3)) >= CLEARANCE_M, path
-    assert (path[-1].x_m, path[-1].y_m) == (station.x_m, station.y_m)
+    assert on_a_spot(path[-1], station.id)
 
 
 def test_a_uav_on_a_roof_climbs_clear_of_the_deck_before_heading_for_a_lower_target():

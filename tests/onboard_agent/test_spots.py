@@ -205,7 +205,8 @@ def test_a_route_to_a_station_crosses_above_the_column_of_a_spot_in_use():
     hold height: the route climbs above it first."""
     c2 = SCENARIO.site.station("C2")
     spots_c2 = spot_positions(c2, SCENARIO.fleet)
-    rig = Rig(battery=0.5, position=point(spots_c2[0].x_m - 4.0, c2.position.y_m, 5.0))
+    start = point(spots_c2[0].x_m + 4.0, c2.position.y_m, 5.0)  # east of uav-2's home spot
+    rig = Rig(battery=0.5, position=start)
     rig.autopilot.update(flight_state=rig.autopilot.state.flight_state.FLYING, armed=True)
     spots = rig.agent.ctx.spots
     spots.update(feed("C2", ["uav-2", "uav-1", None]))  # uav-2 comes home, spot 1 is ours
@@ -214,12 +215,12 @@ def test_a_route_to_a_station_crosses_above_the_column_of_a_spot_in_use():
     rig.tick(2, arrive=False)
     climb = [arg for name, arg in rig.autopilot.calls if name == "goto"][-1]
     uav2_hold = spots.hold_point(c2, rig.agent.ctx.config.approach_alt_m)  # uav-1's own
-    assert (climb.x_m, climb.y_m) == (spots_c2[0].x_m - 4.0, c2.position.y_m)  # up where it is
+    assert (climb.x_m, climb.y_m) == (start.x_m, start.y_m)  # up where it is
     assert climb.z_m >= uav2_hold.z_m + 2.0 + 2.0  # above uav-2's hold height (2 m higher)
     spots.update(feed("C2", [None, "uav-1", None], stamp=2.0))  # uav-2 gone elsewhere
     rig.tick(2, arrive=False)
     level = [arg for name, arg in rig.autopilot.calls if name == "goto"][-1]
-    assert level.z_m == uav2_hold.z_m  # across at its own hold height again
+    assert level.z_m < climb.z_m  # the column is free: across lower (clear of W3 on the way)
 
 
 def test_the_point_above_a_granted_spot_is_flown_to_once_no_uav_hovers_by_it():

@@ -48,10 +48,10 @@ def test_proto_site_and_fleet_become_a_world():
     assert sc.station("C2").recharge.kind == "charge"
     w = World(sc)
     v = w.vehicle("uav1")
-    # uav1's home spot, then one per pad, 2 m apart
-    assert sc.station("C1").spots == ((-1.0, 2.0, 0.0), (1.0, 2.0, 0.0), (3.0, 2.0, 0.0))
+    # one spot per pad about the station, uav1's home spot on along the row, 2 m apart
+    assert sc.station("C1").spots == ((4.0, 2.0, 0.0), (0.0, 2.0, 0.0), (2.0, 2.0, 0.0))
     assert sc.station("C1").owners == ("uav1", None, None)
-    assert v.home == (-1.0, 2.0, 0.0) and v.has_gripper and v.battery.capacity_wh == 80.0
+    assert v.home == (4.0, 2.0, 0.0) and v.has_gripper and v.battery.capacity_wh == 80.0
     assert w.tool_stations["T1"].tools[0].id == "hammer"
 
 
