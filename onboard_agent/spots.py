@@ -60,8 +60,8 @@ class Spots:
         self.uav_id = uav_id
         self.fleet = scenario.fleet
         self.link_clock = link_clock
-        ids = [u.id for u in scenario.fleet.uavs]
-        self.place = ids.index(uav_id) if uav_id in ids else len(ids)
+        self._places = {u.id: i for i, u in enumerate(scenario.fleet.uavs)}
+        self.place = self._place(uav_id)
         self._owners = {s.id: spot_owners(s, self.fleet) for s in scenario.site.stations}
         self.home_station = next(
             (u.home_station for u in scenario.fleet.uavs if u.id == uav_id), None
@@ -90,7 +90,6 @@ class Spots:
         climbs out through it, so a route crosses the column above it as it
         passes a person (chaos seed 15: a UAV flying to its station crossed
         the column another came down through)."""
-        ids = [u.id for u in self.fleet.uavs]
         out = []
         for station in site.stations:
             feed = self._feeds.get(station.id)
@@ -101,8 +100,7 @@ class Spots:
                 other = next((u for u in (granted, landed) if u not in (None, self.uav_id)), None)
                 if other is None:
                     continue
-                place = ids.index(other) if other in ids else len(ids)
-                z = _hold_z(station, approach_alt_m, place)
+                z = _hold_z(station, approach_alt_m, self._place(other))
                 out.append(Point(x_m=point.x_m, y_m=point.y_m, z_m=z))
         return out
 
@@ -189,11 +187,6 @@ class Spots:
         for ``UNUSED_S`` (or ever: a grant it never asked for)."""
         return now_s - self._used_s.get(station_id, -math.inf) > UNUSED_S
 
-    def _mine(self, station_id: str, i: int) -> bool:
-        """Whether spot ``i`` is this UAV's home spot or a shared one."""
-        owners = self._owners.get(station_id, [])
-        return i >= len(owners) or owners[i] in (None, self.uav_id)
-
     def _open(self, station_id: str) -> list[int]:
         """The spots of ``station_id`` this UAV may claim as its last feed
         shows them (every shared one if none was heard)."""
@@ -230,6 +223,10 @@ class Spots:
             return home
         free = self._open(station_id)
         return free[self.place % len(free)] if free else None
+
+    def _place(self, uav_id: str) -> int:
+        """``uav_id``'s place in the fleet (after the fleet's UAVs if unknown)."""
+        return self._places.get(uav_id, len(self._places))
 
     def _home(self, station_id: str) -> int | None:
         owners = self._owners.get(station_id, [])

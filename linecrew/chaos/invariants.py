@@ -102,6 +102,11 @@ class Checker:
         if fleet is not None:
             self._check_executing(at_s, fleet)
         if truth is not None:
+            self._crashed |= {
+                v.uav_id
+                for v in truth.vehicles
+                if v.state == "crashed" and self.excuses.get(v.uav_id)
+            }
             self._check_reserve(at_s, truth)
             self._check_safety(at_s, truth)
             self._check_one_spot(at_s, truth)
@@ -199,8 +204,6 @@ class Checker:
         floor = self.reserve_fraction - self.tolerance
         for vehicle in truth.vehicles:
             uav = vehicle.uav_id
-            if vehicle.state == "crashed" and self.excuses.get(uav):
-                self._crashed.add(uav)
             if vehicle.battery_fraction >= floor or vehicle.state == "crashed":
                 self._below.discard(uav)
                 continue
