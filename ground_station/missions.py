@@ -198,7 +198,7 @@ class MissionManager:
         if isinstance(action, DeliverAction):
             inventory.reserve(self.scenario.site, self.store.actions(), action)
         if isinstance(action, MonitorAction):
-            action = with_bearing(action, self.in_force())
+            action = with_bearing(action, self.in_force(), self.scenario.site)
         action_id = request.action_id or f"act-{self.store.next_counter('action'):05d}"
         if self.store.action(action_id) is not None:
             raise Conflict(f"action id {action_id!r} exists", field="action_id")
@@ -317,7 +317,7 @@ class MissionManager:
             segments = {**record.segments, uav_id: record.segments.get(uav_id, 0) + 1}
             updated = msgspec.structs.replace(record, segments=segments)
             if held is not None and held.action_id == action_id:
-                updated = moved_off(updated, held.slot, self.in_force())
+                updated = moved_off(updated, held.slot, self.in_force(), self.scenario.site)
             self.book.save(updated, record.state, "UAV lost")
 
     def _held_slot(self, uav_id: str, plan: Plan | None) -> MonitorTask | None:

@@ -3,10 +3,12 @@ two of them never send UAVs to one point."""
 
 from __future__ import annotations
 
+import math
+
 import msgspec
 import pytest
 
-from ground_station.monitor_bearings import choose_bearing, slot_bearings
+from ground_station.monitor_bearings import CLEAR_M, choose_bearing, slot_bearings
 from proto import (
     AgentState,
     AgentStatus,
@@ -17,6 +19,7 @@ from proto import (
     SubmitAction,
 )
 from proto.errors import RequestError
+from proto.geo import Point
 from tests.ground_station.harness import ALL
 
 
@@ -40,6 +43,30 @@ def watch(k: int = 1, bearing: float | None = None, worker: str = "W2") -> Monit
 def test_the_bearing_chosen_is_farthest_from_the_other_slots(others, k, expected):
     taken = [b for other in others for b in slot_bearings(other)]
     assert choose_bearing(watch(k), taken) == expected
+
+
+NEIGHBOURS = {"W2": Point(x_m=0, y_m=0, z_m=0), "W1": Point(x_m=-6, y_m=0, z_m=0)}
+
+
+@pytest.mark.parametrize(
+    ("taken", "k", "expected"),
+    [
+        ([], 1, 0.0),  # east of W2: 10 m from W1
+        ([0.0], 1, 120.0),  # 180 (farthest from the other slot) is 2 m from W1
+        ([0.0, 180.0], 1, 90.0),  # taken slots may stand anywhere: only new ones are placed
+        ([], 2, 60.0),  # 0 would put slot 1 (180) 2 m from W1; 60 + 180 is the first clear
+    ],
+)
+def test_a_slot_is_kept_nearer_its_own_worker_than_any_other(taken, k, expected):
+    """A UAV hovering nearer another worker watches that one (the
+    simulator credits it so): the bearing chosen keeps every slot at least
+    ``CLEAR_M`` nearer its own worker, then as far from the taken slots as
+    that allows."""
+    chosen = choose_bearing(watch(k), taken, NEIGHBOURS)
+    assert chosen == expected
+    for b in slot_bearings(watch(k, chosen)):
+        slot = (4 * math.cos(math.radians(b)), 4 * math.sin(math.radians(b)))
+        assert math.dist(slot, (-6.0, 0.0)) >= 4 + CLEAR_M
 
 
 def test_slots_follow_the_bearing_round_the_ring():
