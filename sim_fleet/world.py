@@ -19,7 +19,8 @@ from sim_fleet import physics
 from sim_fleet.events import Severity
 from sim_fleet.geo import GeoFrame
 from sim_fleet.modes import FlightState
-from sim_fleet.safety import SafetyMonitor, Violation
+from sim_fleet.recorder import FlightRecorder
+from sim_fleet.safety import SEPARATION, SafetyMonitor, Violation
 from sim_fleet.scenario import Scenario, Vec3
 from sim_fleet.stations import ChargingStation
 from sim_fleet.terrain import Ground
@@ -66,6 +67,7 @@ class World:
         spots = (p for s in scenario.stations for p in s.spot_points)
         self.safety = SafetyMonitor(scenario.safety, spots, self.rules.dock_radius_m)
         self.watch = WatchLog(self.rules)
+        self.recorder = FlightRecorder()
 
     @property
     def violations(self) -> list[Violation]:
@@ -95,9 +97,20 @@ class World:
                 v.step(h, self.time_s)
                 if v.state is not before:
                     self.safety.transition(v, before, self.time_s)
+            self.recorder.step(self.vehicles.values(), self.time_s)
+            seen = len(self.safety.violations)
             self.safety.check(self.vehicles.values(), self.workers, self.time_s)
+            self._log_tracks(self.safety.violations[seen:])
             self.watch.step(self.vehicles.values(), self.workers, h)
             self._recharge(h)
+
+    def _log_tracks(self, violations: list[Violation]) -> None:
+        """Log how the two vehicles of each new separation violation came together."""
+        for v in violations:
+            if v.kind == SEPARATION:
+                pair = (v.vehicle_id, v.detail.split()[0])
+                lines = "\n".join(self.recorder.track(pair))
+                log.warning("separation %s/%s at %.1f s, last seconds:\n%s", *pair, v.time_s, lines)
 
     def _recharge(self, dt_s: float) -> None:
         dock_r = self.rules.dock_radius_m

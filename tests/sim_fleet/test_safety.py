@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import dataclasses
 import itertools
+import logging
 import math
 import random
 import re
@@ -137,6 +138,22 @@ def test_separation_recorded_once_under_the_lower_id():
     goto(w, u1, (0.0, 50.0, 0.8))
     assert kinds(w)[2:] == [("separation", "u1", "u3")]
     assert u3.state is FlightState.LANDED
+
+
+def test_a_separation_is_logged_with_how_the_two_came_together(caplog):
+    """The flight recorder: each vehicle's positions and targets over the
+    last seconds, so a near collision in a chaos run can be diagnosed."""
+    w = world(n=2, homes=("S1", "S2"))
+    u1, u2 = w.vehicle("u1"), w.vehicle("u2")
+    airborne(w, u1, 10.0)
+    airborne(w, u2, 10.0)
+    with caplog.at_level(logging.WARNING, logger="sim_fleet.world"):
+        goto(w, u2, (0.6, 0.0, 10.0))
+    [record] = [r for r in caplog.records if "separation u1/u2" in r.getMessage()]
+    track = record.getMessage().splitlines()[1:]
+    assert len(track) >= 10
+    assert all("u1 (" in line and "u2 (" in line for line in track)
+    assert "-> (0.6, 0.0, 10.0) flying" in track[-1]  # where u2 was sent
 
 
 def test_safety_distances_come_from_the_scenario():
