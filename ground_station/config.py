@@ -5,6 +5,9 @@ from __future__ import annotations
 import dataclasses
 import os
 
+MIN_TRAFFIC_PERIOD_S = 0.05
+"""Traffic reports at most 20 times a wall second, whatever the speed-up."""
+
 
 @dataclasses.dataclass(frozen=True, kw_only=True)
 class GsConfig:
@@ -23,6 +26,13 @@ class GsConfig:
     improve_attempts: int = 10  # attempts per state at most, while each gains
     session_window_s: float = 10.0  # mission s a planning session serves incremental replans
     improve_delay_s: float = 0.5  # quiet wall seconds after a trigger before improving
+    traffic_period_s: float = 0.5  # wall s between two traffic reports (see ``traffic_period``)
+
+    def traffic_period(self, speedup: float) -> float:
+        """Wall seconds between traffic reports under ``speedup``: the same
+        mission seconds as at x1 (UAVs move ``speedup`` times as far between
+        two reports), never below ``MIN_TRAFFIC_PERIOD_S``."""
+        return max(MIN_TRAFFIC_PERIOD_S, self.traffic_period_s / max(speedup, 1.0))
 
     @classmethod
     def from_env(cls, **overrides: object) -> GsConfig:

@@ -47,7 +47,9 @@ def main(argv: list[str] | None = None) -> int:
         return 1
     with bus:
         try:
-            station = GroundStation(config, scenario, bus, clock=mission_clock(args.speedup))
+            station = GroundStation(
+                config, scenario, bus, clock=mission_clock(args.speedup), speedup=args.speedup
+            )
         except StoreUnavailable as exc:
             log.error("ground station cannot start: %s", exc)
             return 1

@@ -35,7 +35,6 @@ from proto.rpc import REQUEST_OPS, GetMetrics, GetPlans, MetricsReply, PlansRepl
 from proto.scenario import Scenario
 from proto.telemetry import AgentStatus, TaskOutcome, Telemetry
 
-TRAFFIC_PERIOD_S = 0.5
 FUTURE_TOLERANCE_S = 60.0
 """How far ahead of the mission clock a UAV's sample may be stamped (clock skew
 between machines); later stamps are forged or broken: dropped, counted."""
@@ -52,8 +51,10 @@ class GroundStation:
         scenario: Scenario,
         bus: Bus,
         clock: Callable[[], float] = time.time,
+        speedup: float = 1.0,
     ) -> None:
         self.config = config
+        self.traffic_period_s = config.traffic_period(speedup)
         self.bus = bus
         self.clock = clock
         self.keys = KeySpace(scenario.site.id)
@@ -180,7 +181,7 @@ class GroundStation:
             await asyncio.sleep(self.config.watchdog_period_s)
 
     async def _traffic(self) -> None:
-        """Tell the agents where every UAV is, ``TRAFFIC_PERIOD_S`` apart."""
+        """Tell the agents where every UAV is, ``traffic_period_s`` apart."""
         while True:
             try:
                 report = self.monitor.traffic(time.monotonic())
@@ -189,7 +190,7 @@ class GroundStation:
                 self.bus.publish(self.keys.traffic(), announced)
             except Exception:
                 log.exception("traffic report not sent")
-            await asyncio.sleep(TRAFFIC_PERIOD_S)
+            await asyncio.sleep(self.traffic_period_s)
 
     def _rpc_handler(self, op: str) -> Callable[[Request], Reply]:
         def handle(request: Request) -> Reply:

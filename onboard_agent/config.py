@@ -12,6 +12,8 @@ import os
 from collections.abc import Callable, Mapping
 
 ENV_PREFIX = "LINECREW_AGENT_"
+MAX_TELEMETRY_HZ = 20.0
+"""Telemetry at most this often (wall), whatever the speed-up."""
 
 
 @dataclasses.dataclass(frozen=True, kw_only=True)
@@ -40,7 +42,6 @@ class AgentConfig:
     wait_aside_m: float = 3.0  # an airborne wait after monitoring hovers this far along the ring
     keep_clear_m: float = 2.0  # never fly to a point another airborne UAV is this near (traffic)
     yield_max_s: float = 30.0  # hold off at most this long (mission s), then fly on
-    handover_grace_s: float = 10.0  # a relief closes in on its slot this long whoever is there
     relief_wait_s: float = 60.0  # past its segment's end, wait this long at most for the relief
     goto_resend_s: float = 1.0  # repeat a position target this often (no ACK exists)
     task_attempts: int = 3  # a task whose subtree failed this often is reported failed
@@ -78,6 +79,13 @@ class AgentConfig:
         config = cls(**values)  # type: ignore[arg-type]
         config.check()
         return config
+
+    def at_speedup(self, speedup: float) -> AgentConfig:
+        """These settings for a mission clock ``speedup`` times real time:
+        telemetry as often in mission seconds as at x1 (other UAVs steer
+        clear of where it says this one is), at most ``MAX_TELEMETRY_HZ``."""
+        hz = min(MAX_TELEMETRY_HZ, self.telemetry_hz * max(speedup, 1.0))
+        return dataclasses.replace(self, telemetry_hz=max(hz, self.telemetry_hz))
 
     def check(self) -> None:
         """Raise ``ValueError`` for settings that cannot work."""

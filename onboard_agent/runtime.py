@@ -77,7 +77,9 @@ async def run_agent(
     """Fly ``uav_id`` until ``stop`` completes; then stop ticking and close
     the bus and the MAVLink link. Keys use ``site`` (default: the scenario's).
     Task durations and plan times run on the mission clock (``speedup``);
-    link timeouts on real time. With ``signing_key`` the MAVLink link is signed."""
+    link timeouts on real time; telemetry keeps its rate in mission time
+    (:meth:`AgentConfig.at_speedup`). With ``signing_key`` the MAVLink link is signed."""
+    config = config.at_speedup(speedup)
     frame = SiteFrame(scenario.site.origin)
     link = MavlinkLink(autopilot_url, frame, config, signing_key=signing_key)
     agent = Agent(

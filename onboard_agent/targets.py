@@ -129,17 +129,6 @@ def awaiting_relief(ctx: Context) -> bool:
     return slot is not None and (there is None or there.distance_to(slot) > near_m)
 
 
-def _not_handing_over(ctx: Context) -> bool:
-    """Whether a UAV at the head segment's slot is in the way: not in the
-    first ``handover_grace_s`` of the segment's window, when the UAV it
-    relieves is due to leave (the traffic report lags by seconds)."""
-    task = ctx.mission.head
-    if not isinstance(task, MonitorTask) or task.end_s <= 0:
-        return True
-    start = task.window_start_s
-    return not start <= ctx.wall() < start + ctx.config.handover_grace_s
-
-
 def wait_aside(ctx: Context) -> Point | None:
     """Where an airborne wait that follows a monitoring segment hovers:
     ``wait_aside_m`` along the ring from the slot it left, clear of the
@@ -276,9 +265,7 @@ def station_target(pick: Callable[[Context], ChargingStation | None]) -> Target:
 
 
 WAYPOINT = Target("WP", waypoint, lambda c: c.config.near_waypoint_m)
-HUMAN_SLOT = Target(
-    "Human Target", monitor_slot, lambda c: c.config.near_slot_m, keep_clear=_not_handing_over
-)
+HUMAN_SLOT = Target("Human Target", monitor_slot, lambda c: c.config.near_slot_m)
 WAIT_ASIDE = Target("Aside", wait_aside, lambda c: c.config.near_slot_m)
 HUMAN_DROP = Target("Human Target", drop_point, lambda c: c.config.near_human_m, settle=True)
 TOOL_STATION = Target("Station", pick_point, lambda c: c.config.near_tool_station_m, settle=True)

@@ -16,8 +16,10 @@ flies its plan as before.
 
 from __future__ import annotations
 
+import math
 from typing import NamedTuple
 
+from onboard_agent.surroundings import horizontal_distance
 from proto.geo import Point
 from proto.telemetry import Traffic as TrafficReport
 
@@ -60,16 +62,35 @@ class Traffic:
             (s.where for s in self._others(now_s) if s.uav_id == uav_id and not s.target), None
         )
 
-    def holder(self, point: Point, radius_m: float, now_s: float) -> str | None:
+    def holder(
+        self, point: Point, radius_m: float, now_s: float, here: Point | None = None
+    ) -> Sighting | None:
         """Another airborne UAV within ``radius_m`` of ``point``, if any (the
         nearest): where it was heard, or, unheard for ``UNHEARD_S``, the
-        target it was flying to."""
-        near = [
-            (s.where.distance_to(point), s.uav_id)
-            for s in self._others(now_s)
-            if s.unheard or not s.target
+        target it was flying to. From ``here``, also one heard nearer
+        ``point`` (ties: the lower id) whose target is within ``radius_m``
+        of it horizontally, at its height or above (coming down to it):
+        of two UAVs sent to one point, the nearer goes first (chaos seed
+        18: one came back to a slot as another came down to it)."""
+        others = self._others(now_s)
+        near = [(s.where.distance_to(point), s) for s in others if s.unheard or not s.target]
+        gap, nearest = min(near, key=lambda n: n[0], default=(math.inf, None))
+        if gap < radius_m:
+            return nearest
+        if here is None:
+            return None
+        heard = {s.uav_id: s.where for s in others if not s.target and not s.unheard}
+        mine = (here.distance_to(point), self.uav_id)
+        coming = [
+            (heard[s.uav_id].distance_to(point), s.uav_id, s)
+            for s in others
+            if s.target
+            and s.uav_id in heard
+            and horizontal_distance(s.where, point) < radius_m
+            and s.where.z_m > point.z_m - radius_m
         ]
-        return min(near)[1] if near and min(near)[0] < radius_m else None
+        first = [c for c in coming if c[:2] < mine]
+        return min(first, key=lambda c: c[:2])[2] if first else None
 
     def obstacles(self, now_s: float) -> list[Point]:
         """Where other airborne UAVs hover or are about to: heard at their

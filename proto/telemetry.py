@@ -57,7 +57,8 @@ class TrafficEntry(Record, frozen=True, kw_only=True):
 
 
 class Traffic(Message, frozen=True, kw_only=True):
-    """Where the fleet's UAVs are, from the ground station twice a second
+    """Where the fleet's UAVs are, from the ground station twice a mission second (at most
+    20 times a wall second)
     on ``gs/traffic``: agents keep clear of points another UAV hovers at.
 
     It also announces the ground station: ``generation`` (one id per

@@ -179,28 +179,32 @@ class GoNear(AgentBehaviour):
 
     def _yielding(self, point: Point, now: float) -> bool:
         """Hold where the UAV is while another airborne UAV is at ``point``
-        (from the traffic report), for at most ``yield_max_s``."""
+        (from the traffic report): as long as it is heard there (flying on
+        would fly into it; chaos seed 16: a relief came down onto the UAV it
+        relieved, still watching from the slot), at most ``yield_max_s`` if
+        it is only thought to be there (unheard, at the target it flew to:
+        a hung agent; the ground station moves a lost UAV's slot)."""
         ctx, config = self.ctx, self.ctx.config
         radius = max(config.keep_clear_m, ctx.surroundings.site.safety.separation_m)
         here = ctx.vehicle.position
         other = None
         if here.distance_to(point) >= radius and self.target.keep_clear(ctx):
-            other = ctx.traffic.holder(point, radius, ctx.link_clock())
+            other = ctx.traffic.holder(point, radius, ctx.link_clock(), here)
         if other is None:
             self._yield_since = ctx.holding_for = None
             return False
         if self._yield_since is None:
             self._yield_since = now
             self._sent = None
-        if now - self._yield_since > config.yield_max_s:
+        if other.unheard and now - self._yield_since > config.yield_max_s:
             ctx.holding_for = None
-            return False  # it has not moved for long: fly on (the plan knows no better)
-        ctx.holding_for = other
+            return False  # not heard for long: fly on (the plan knows no better)
+        ctx.holding_for = other.uav_id
         if self._sent is None or now - self._sent_at >= config.goto_resend_s:
             self._sent = self._sent or here
             ctx.goto(self._sent)
             self._sent_at = now
-        self.feedback_message = f"holding off: {other} is at the {self.target.label}"
+        self.feedback_message = f"holding off: {other.uav_id} is at the {self.target.label}"
         return True
 
     def terminate(self, new_status: Status) -> None:

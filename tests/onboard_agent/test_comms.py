@@ -76,7 +76,7 @@ def test_comms_round_trip(bus_config):
             gs_bus.publish(KEYS.traffic(), report)
             traffic = rig.agent.ctx.traffic
             await until(lambda: traffic.holder(there, 1.0, rig.clock()), what="traffic report")
-            assert traffic.holder(there, 1.0, rig.clock()) == "uav-2"
+            assert traffic.holder(there, 1.0, rig.clock()).uav_id == "uav-2"
 
             surroundings = rig.agent.ctx.surroundings
             site_w1 = surroundings.worker_position("W1")

@@ -182,17 +182,27 @@ def test_a_uav_that_never_leaves_the_point_is_waited_for_at_most_yield_max_s():
     assert rig.agent.status().holding_for is None  # it flew on: no longer holding off
 
 
-def test_a_relief_closes_in_at_its_window_though_the_uav_it_relieves_still_shows_there():
+def test_a_relief_waits_while_the_uav_it_relieves_is_heard_at_the_slot():
+    """Chaos seed 16: a relief came down onto the UAV it relieved, still
+    watching from the slot (their plans disagreed on when it ends). The
+    relief holds off, past ``yield_max_s`` too, as long as that UAV is heard
+    there, and closes in once it has left."""
     rig = Rig()
     start = rig.wall() + 5.0
     task = msgspec.structs.replace(
-        monitor(slot=0, slots=1, duration_s=30.0), start_s=rig.wall(), end_s=start + 30.0
+        monitor(slot=0, slots=1, duration_s=120.0), start_s=rig.wall(), end_s=start + 120.0
     )
     rig.agent.offer_plan(plan(task))
     slot = point(W2.x_m + 4.0, W2.y_m, W2.z_m + task.height_m)
-    _traffic_at(rig, slot)  # the relieved UAV, as the (lagging) report last heard it
-    rig.run_until(lambda: rig.wall() >= start + 0.5)
-    assert last_goto(rig).distance_to(slot) < 0.1  # its turn: it closes in all the same
+    waited_until = start + rig.agent.ctx.config.yield_max_s + 5.0
+    while rig.wall() < waited_until:
+        _traffic_at(rig, slot)  # the relieved UAV, heard at the slot
+        rig.tick(1)
+    assert last_goto(rig).distance_to(slot) > rig.agent.ctx.config.keep_clear_m
+    assert rig.agent.status().holding_for == "uav-2"
+    _traffic_at(rig, point(slot.x_m, slot.y_m + 6.0, slot.z_m))  # it has left
+    rig.run_until(lambda: rig.leaf() == "Monitoring")
+    assert rig.autopilot.state.position.distance_to(slot) < 0.1
 
 
 def _relieved_segment(rig, duration_s: float = 6.0) -> MonitorTask:
@@ -266,7 +276,11 @@ def test_a_uav_no_longer_heard_is_kept_clear_of_at_the_target_it_flew_to():
     heard = TrafficEntry(uav_id="uav-2", position=short, airborne=True, age_s=0.2, target=slot)
     rig.agent.ctx.traffic.update(Traffic(uavs=[heard]), rig.clock())
     rig.tick(2, arrive=False)
-    assert rig.agent.status().holding_for is None  # just heard: it is where it was heard
+    assert rig.agent.status().holding_for == "uav-2"  # heard nearer, coming: it goes first
+    bound = msgspec.structs.replace(heard, target=point(slot.x_m + 2.4, slot.y_m + 9.0, slot.z_m))
+    rig.agent.ctx.traffic.update(Traffic(uavs=[bound]), rig.clock())
+    rig.tick(2, arrive=False)
+    assert rig.agent.status().holding_for is None
     unheard = msgspec.structs.replace(heard, age_s=5.0)
     rig.agent.ctx.traffic.update(Traffic(uavs=[unheard]), rig.clock())
     rig.tick(2, arrive=False)

@@ -1,0 +1,58 @@
+"""Who holds a point, from the traffic report: a UAV heard at it, one
+unheard whose target it was, and, of two sent to it, the nearer."""
+
+from __future__ import annotations
+
+import pytest
+
+from onboard_agent.traffic import Traffic
+from proto.geo import Point
+from proto.telemetry import Traffic as TrafficReport
+from proto.telemetry import TrafficEntry
+
+SLOT = Point(x_m=0.0, y_m=0.0, z_m=6.0)
+
+
+def report(*entries: TrafficEntry) -> Traffic:
+    traffic = Traffic("uav-1")
+    traffic.update(TrafficReport(uavs=list(entries)), 0.0)
+    return traffic
+
+
+def entry(at: Point, target: Point | None = None, age_s: float = 0.2) -> TrafficEntry:
+    return TrafficEntry(uav_id="uav-2", position=at, airborne=True, age_s=age_s, target=target)
+
+
+def p(x: float, y: float, z: float) -> Point:
+    return Point(x_m=x, y_m=y, z_m=z)
+
+
+def test_a_uav_heard_at_the_point_holds_it_and_is_known_heard():
+    seen = report(entry(p(0.5, 0.0, 6.0))).holder(SLOT, 2.0, 0.0)
+    assert seen is not None and (seen.uav_id, seen.unheard) == ("uav-2", False)
+
+
+def test_one_unheard_holds_the_target_it_flew_to():
+    traffic = report(entry(p(10.0, 0.0, 6.0), target=SLOT, age_s=5.0))
+    seen = traffic.holder(SLOT, 2.0, 0.0)
+    assert seen is not None and seen.unheard
+
+
+@pytest.mark.parametrize(
+    ("other_at", "other_target", "me", "yields"),
+    [
+        (p(0.0, 0.0, 8.5), p(0.0, 0.0, 6.0), p(2.9, 0.0, 6.0), True),  # coming down, nearer
+        (p(0.0, 0.0, 8.5), p(0.0, 0.0, 8.5), p(2.9, 0.0, 6.0), True),  # above it, about to
+        (p(0.0, 0.0, 8.5), p(0.0, 0.0, 6.0), p(2.0, 0.0, 6.0), False),  # I am nearer: I go
+        (p(5.0, 0.0, 6.0), p(0.0, 0.0, 6.0), p(2.9, 0.0, 6.0), False),  # it is farther
+        (p(0.0, 3.0, 6.0), p(0.0, 6.0, 6.0), p(2.9, 0.0, 6.0), False),  # sent elsewhere
+        (p(0.0, 0.0, 2.0), p(0.0, 0.0, 2.0), p(2.9, 0.0, 6.0), False),  # below, not coming up
+    ],
+)
+def test_of_two_uavs_sent_to_one_point_the_nearer_goes_first(other_at, other_target, me, yields):
+    """Chaos seed 18: one UAV came back to a slot from beside it as another
+    came down to it from above; each was more than 2 m from the slot."""
+    traffic = report(entry(other_at, target=other_target))
+    seen = traffic.holder(SLOT, 2.0, 0.0, here=me)
+    assert (seen is not None and seen.uav_id == "uav-2") is yields
+    assert traffic.holder(SLOT, 2.0, 0.0) is None  # nobody is at the point itself
