@@ -33,3 +33,10 @@ def test_environment_then_overrides():
 def test_bad_values_are_refused(env):
     with pytest.raises(ValueError):
         AgentConfig.from_env(env)
+
+
+@pytest.mark.parametrize(("speedup", "hz"), [(1.0, 5.0), (2.0, 10.0), (10.0, 20.0), (0.5, 5.0)])
+def test_telemetry_keeps_its_rate_in_mission_time_up_to_20_hz(speedup, hz):
+    """Others steer clear of where a UAV's telemetry says it is: at x10 a
+    5 Hz report would be 2 mission seconds (4 m of flight) old."""
+    assert AgentConfig().at_speedup(speedup).telemetry_hz == hz
