@@ -34,6 +34,20 @@ target) a leg counts as flown."""
 ABOVE_M = 1.0
 """An obstacle this close horizontally and higher is right above the UAV:
 climbing over it would fly into it."""
+LEVEL_STEP_M = 2.0
+"""Cruise levels of UAVs at neighbouring places in the fleet lie this far
+apart (see :func:`own_level`), as their hold heights over a station do."""
+LEVEL_BASE_M = 5.0
+"""A level of the UAV at place 0: its hold height over a station on the
+ground (the approach height plus one step, :mod:`onboard_agent.spots`), so
+that each UAV's hold heights are levels of its own."""
+MAX_LAYERS = 4
+"""Places in the fleet that cruise at levels of their own; beyond it,
+places share levels (place modulo this)."""
+SIDESTEP_M = 2.0
+"""A climb (or a descent) passes no obstacle nearer than this horizontally:
+the UAV first moves level this far from it (chaos seed 13: a UAV climbed
+out of its spot into one hovering 0.8 m beside its column)."""
 
 
 def ground_distance(p: Point, a: Point, b: Point) -> float:
@@ -52,12 +66,15 @@ def next_leg(
     clear_m: float,
     cruise_z: float | None = None,
     columns: Iterable[Point] = (),
+    layer: tuple[int, int] | None = None,
 ) -> Point:
     """The point to send the autopilot now on the way from ``here`` to
     ``target``; with ``cruise_z`` the flight is legged anyway and crosses
     at that height at least (a height of the UAV's own, clear of others).
     ``columns`` are crossed above like ``people``, even beside the target
-    (the spots where other UAVs land and take off)."""
+    (the spots where other UAVs land and take off). With ``layer`` (the
+    UAV's place in the fleet, the fleet's size) a legged flight crosses at
+    the UAV's own level (:func:`own_level`)."""
     low = min(here.z_m, target.z_m)
 
     def near(points: Iterable[Point]) -> list[Point]:
@@ -79,8 +96,46 @@ def next_leg(
         [here.z_m, target.z_m, cruise_z or -math.inf]
         + [p.z_m + clear_m for p in crossed if not above(p)]
     )
+    if layer is not None:
+        crossing = own_level(crossing, *layer)
     if math.hypot(target.x_m - here.x_m, target.y_m - here.y_m) <= TOLERANCE_M:
-        return target  # straight up or down to it
+        return _sidestep(here, target, people, target.z_m) or target  # straight up or down
     if here.z_m < crossing - TOLERANCE_M:
-        return Point(x_m=here.x_m, y_m=here.y_m, z_m=crossing)
+        up = Point(x_m=here.x_m, y_m=here.y_m, z_m=crossing)
+        return _sidestep(here, target, people, crossing) or up
     return Point(x_m=target.x_m, y_m=target.y_m, z_m=crossing)
+
+
+def _sidestep(here: Point, target: Point, obstacles: Iterable[Point], to_z: float) -> Point | None:
+    """Where to move level first, if going up or down at ``here`` to
+    ``to_z`` would pass within ``SIDESTEP_M`` (horizontally) of an obstacle
+    on the way (from the UAV's height to 1 m past ``to_z``): ``SIDESTEP_M``
+    from the nearest such, away
+    from it (right below or above it: towards the target)."""
+    up = to_z > here.z_m
+    low, high = (here.z_m, to_z + 1.0) if up else (to_z - 1.0, here.z_m)
+    blocking = [
+        p for p in obstacles if ground_distance(p, here, here) < SIDESTEP_M and low < p.z_m < high
+    ]
+    if not blocking:
+        return None
+    p = min(blocking, key=lambda b: ground_distance(b, here, here))
+    dx, dy = here.x_m - p.x_m, here.y_m - p.y_m
+    if math.hypot(dx, dy) < TOLERANCE_M:
+        dx, dy = target.x_m - here.x_m, target.y_m - here.y_m
+    if math.hypot(dx, dy) < TOLERANCE_M:
+        dx, dy = 1.0, 0.0
+    scale = (SIDESTEP_M + TOLERANCE_M) / math.hypot(dx, dy)
+    return Point(x_m=p.x_m + dx * scale, y_m=p.y_m + dy * scale, z_m=here.z_m)
+
+
+def own_level(z_m: float, place: int, fleet_size: int) -> float:
+    """The lowest cruise level at or above ``z_m`` of the UAV at ``place``
+    in a fleet of ``fleet_size``: levels ``LEVEL_STEP_M`` apart from one
+    place to the next, so two UAVs crossing at once never cruise at one
+    height (chaos seed 17: two took off from one station and crossed at
+    11.5 m both)."""
+    layers = max(1, min(fleet_size, MAX_LAYERS))
+    cycle = LEVEL_STEP_M * layers
+    base = LEVEL_BASE_M + LEVEL_STEP_M * (place % layers)
+    return base + cycle * math.ceil((z_m - base) / cycle - 1e-9)

@@ -155,6 +155,12 @@ class Spots:
         self._wanted = (station.id, free) if free is not None else None
         return None
 
+    @property
+    def layer(self) -> tuple[int, int]:
+        """This UAV's place in the fleet and the fleet's size: the cruise
+        levels of its own (:func:`onboard_agent.route.own_level`)."""
+        return self.place, len(self.fleet.uavs)
+
     def hold_point(self, station: ChargingStation, approach_alt_m: float) -> Point:
         """Where this UAV waits for a spot at ``station``: beside its row of
         spots (``HOLD_ASIDE_M``), at a height of its own."""

@@ -68,8 +68,7 @@ class Traffic:
         """Another airborne UAV within ``radius_m`` of ``point``, if any (the
         nearest): where it was heard, or, unheard for ``UNHEARD_S``, the
         target it was flying to. From ``here``, also one heard nearer
-        ``point`` (ties: the lower id) whose target is within ``radius_m``
-        of it horizontally, at its height or above (coming down to it):
+        ``point`` (ties: the lower id) on its way to it (:func:`_coming`):
         of two UAVs sent to one point, the nearer goes first (chaos seed
         18: one came back to a slot as another came down to it)."""
         others = self._others(now_s)
@@ -84,10 +83,7 @@ class Traffic:
         coming = [
             (heard[s.uav_id].distance_to(point), s.uav_id, s)
             for s in others
-            if s.target
-            and s.uav_id in heard
-            and horizontal_distance(s.where, point) < radius_m
-            and s.where.z_m > point.z_m - radius_m
+            if s.target and s.uav_id in heard and _coming(heard[s.uav_id], s.where, point, radius_m)
         ]
         first = [c for c in coming if c[:2] < mine]
         return min(first, key=lambda c: c[:2])[2] if first else None
@@ -117,3 +113,16 @@ class Traffic:
             if e.target is not None:
                 out.append(Sighting(e.uav_id, e.target, unheard, target=True))
         return out
+
+
+def _coming(where: Point, target: Point, point: Point, radius_m: float) -> bool:
+    """Whether a UAV heard at ``where`` flying to ``target`` is on its way
+    to ``point`` (or to above it, to come down): moving, not climbing, its
+    target within ``radius_m`` of ``point`` horizontally and at its height
+    or above. A UAV hovering (holding where it is) is not on its way."""
+    return (
+        where.distance_to(target) >= HOVER_M
+        and where.z_m >= target.z_m - HOVER_M
+        and horizontal_distance(target, point) < radius_m
+        and target.z_m > point.z_m - radius_m
+    )

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import logging
+
 from onboard_agent import route
 from onboard_agent.autopilot.errors import CommandDenied, CommandTimeout
 from onboard_agent.autopilot.protocol import GUIDED
@@ -10,6 +12,8 @@ from onboard_agent.context import Context
 from onboard_agent.targets import Target
 from proto.geo import Point
 from proto.telemetry import FlightState
+
+log = logging.getLogger(__name__)
 
 LIFTOFF_TIMEOUT_S = 10.0  # still on the ground this long after takeoff: start over
 
@@ -168,7 +172,8 @@ class GoNear(AgentBehaviour):
         )
         columns = ctx.spots.busy_columns(ctx.surroundings.site, config.approach_alt_m)
         cruise_z = self.target.cruise_z(ctx)
-        leg = route.next_leg(vehicle.position, point, obstacles, clear_m, cruise_z, columns)
+        layer = ctx.spots.layer
+        leg = route.next_leg(vehicle.position, point, obstacles, clear_m, cruise_z, columns, layer)
         moved = self._sent is None or self._sent.distance_to(leg) > config.follow_threshold_m
         if moved or now - self._sent_at >= config.goto_resend_s:
             ctx.goto(leg)
@@ -183,7 +188,9 @@ class GoNear(AgentBehaviour):
         would fly into it; chaos seed 16: a relief came down onto the UAV it
         relieved, still watching from the slot), at most ``yield_max_s`` if
         it is only thought to be there (unheard, at the target it flew to:
-        a hung agent; the ground station moves a lost UAV's slot)."""
+        a hung agent; the ground station moves a lost UAV's slot) or this
+        UAV is in an emergency (its battery decides: two UAVs low on energy
+        holding for each other at a station must not both fall, seed 12)."""
         ctx, config = self.ctx, self.ctx.config
         radius = max(config.keep_clear_m, ctx.surroundings.site.safety.separation_m)
         here = ctx.vehicle.position
@@ -196,9 +203,16 @@ class GoNear(AgentBehaviour):
         if self._yield_since is None:
             self._yield_since = now
             self._sent = None
-        if other.unheard and now - self._yield_since > config.yield_max_s:
+            log.info(
+                "holding off: %s is at the %s",
+                other.uav_id,
+                self.target.label,
+                extra={"uav_id": ctx.uav_id},
+            )
+        bounded = other.unheard or bool(ctx.emergency)
+        if bounded and now - self._yield_since > config.yield_max_s:
             ctx.holding_for = None
-            return False  # not heard for long: fly on (the plan knows no better)
+            return False  # not heard for long, or no time left: fly on
         ctx.holding_for = other.uav_id
         if self._sent is None or now - self._sent_at >= config.goto_resend_s:
             self._sent = self._sent or here

@@ -11,7 +11,7 @@ import msgspec
 import pytest
 
 from onboard_agent import AgentConfig
-from onboard_agent.route import ground_distance, next_leg
+from onboard_agent.route import SIDESTEP_M, ground_distance, next_leg, own_level
 from onboard_agent.spots import Spots
 from proto.telemetry import FlightState
 from tests.onboard_agent.helpers import SCENARIO, Rig, on_a_spot, point
@@ -47,6 +47,38 @@ def test_a_uav_hovering_right_above_is_left_level_never_climbed_into():
     above, below = point(0, 3, 9), point(0, 3, 5)
     assert next_leg(here, spot, [above], CLEAR_M) == point(0, 0, 7)
     assert next_leg(here, spot, [below], CLEAR_M) == point(0, 3, 5 + CLEAR_M)
+
+
+def test_a_climb_or_a_descent_moves_level_first_clear_of_one_hovering_beside():
+    """Chaos seed 13: a UAV climbing out of its spot to cross over a far
+    waypoint rose into one hovering 0.8 m beside its column. It moves level
+    to 2 m from that one first, then climbs (and crosses over it too)."""
+    here, target = point(1, 20, 6), point(5, -3, 17)
+    beside = point(1.7, 20.4, 11.8)
+    obstacles = [beside, point(5, -3, 17)]  # the far waypoint raises the crossing
+    first = next_leg(here, target, obstacles, CLEAR_M)
+    assert first.z_m == here.z_m  # level
+    assert ground_distance(beside, first, first) >= SIDESTEP_M
+    up = next_leg(first, target, obstacles, CLEAR_M)
+    assert (up.x_m, up.y_m) == (first.x_m, first.y_m) and up.z_m >= beside.z_m + CLEAR_M
+    # straight down onto a target: first clear of one hovering on the way
+    down = next_leg(point(0, 0, 12), point(0, 0, 6), [point(0.5, 0, 9)], CLEAR_M)
+    assert down.z_m == 12 and ground_distance(point(0.5, 0, 9), down, down) >= SIDESTEP_M
+
+
+def test_uavs_at_different_places_cross_at_levels_2_m_apart():
+    """Chaos seed 17: two UAVs took off from one station and crossed each
+    other at 11.5 m both. Each crosses at a level of its own; hold heights
+    over a station on the ground are levels of their own UAV."""
+    for need in (3.0, 5.5, 11.5, 19.0):
+        levels = [own_level(need, place, 3) for place in range(3)]
+        assert all(z >= need for z in levels)
+        assert min(abs(a - b) for a, b in itertools.combinations(levels, 2)) >= 2.0
+    assert [own_level(5.0 + 2.0 * p, p, 3) for p in range(3)] == [5.0, 7.0, 9.0]
+    assert own_level(6.0, 4, 100) == own_level(6.0, 0, 100)  # beyond 4 places, shared
+    here, target = point(0, 0, 5), point(20, 0, 5)
+    legs = [next_leg(here, target, [point(10, 0, 3)], CLEAR_M, layer=(p, 3)) for p in range(3)]
+    assert [leg.z_m for leg in legs] == [own_level(3 + CLEAR_M, p, 3) for p in range(3)]
 
 
 def test_a_target_placed_beside_a_person_is_reached_from_above():

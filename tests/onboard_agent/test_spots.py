@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import math
 
+from onboard_agent.route import own_level
 from onboard_agent.spots import STALE_S
 from proto.plan import RechargeTask
 from proto.spots import StationSpots, spot_positions
@@ -220,7 +221,10 @@ def test_a_route_to_a_station_crosses_above_the_column_of_a_spot_in_use():
     spots.update(feed("C2", [None, "uav-1", None], stamp=2.0))  # uav-2 gone elsewhere
     rig.tick(2, arrive=False)
     level = [arg for name, arg in rig.autopilot.calls if name == "goto"][-1]
-    assert level.z_m < climb.z_m  # the column is free: across lower (clear of W3 on the way)
+    w3 = SCENARIO.site.worker("W3").position
+    clear = SCENARIO.site.safety.people_clearance_m + rig.agent.ctx.config.route_margin_m
+    # the column is free: across at uav-1's lowest level clear of W3 on the way
+    assert level.z_m == own_level(w3.z_m + clear, *spots.layer)
 
 
 def test_the_point_above_a_granted_spot_is_flown_to_once_no_uav_hovers_by_it():

@@ -42,7 +42,9 @@ def test_one_unheard_holds_the_target_it_flew_to():
     ("other_at", "other_target", "me", "yields"),
     [
         (p(0.0, 0.0, 8.5), p(0.0, 0.0, 6.0), p(2.9, 0.0, 6.0), True),  # coming down, nearer
-        (p(0.0, 0.0, 8.5), p(0.0, 0.0, 8.5), p(2.9, 0.0, 6.0), True),  # above it, about to
+        (p(2.0, 0.0, 8.5), p(0.0, 0.0, 8.5), p(3.5, 0.0, 6.0), True),  # to above it, to come down
+        (p(0.0, 0.0, 8.5), p(0.0, 0.0, 8.5), p(2.9, 0.0, 6.0), False),  # hovering: maybe holding
+        (p(0.0, 0.0, 3.0), p(0.0, 0.0, 11.0), p(2.9, 0.0, 6.0), False),  # climbing past it
         (p(0.0, 0.0, 8.5), p(0.0, 0.0, 6.0), p(2.0, 0.0, 6.0), False),  # I am nearer: I go
         (p(5.0, 0.0, 6.0), p(0.0, 0.0, 6.0), p(2.9, 0.0, 6.0), False),  # it is farther
         (p(0.0, 3.0, 6.0), p(0.0, 6.0, 6.0), p(2.9, 0.0, 6.0), False),  # sent elsewhere
