@@ -73,8 +73,10 @@ def next_leg(
     at that height at least (a height of the UAV's own, clear of others).
     ``columns`` are crossed above like ``people``, even beside the target
     (the spots where other UAVs land and take off). With ``layer`` (the
-    UAV's place in the fleet, the fleet's size) a legged flight crosses at
-    the UAV's own level (:func:`own_level`)."""
+    UAV's place in the fleet, the fleet's size) a flight that crosses over
+    something, higher than both its ends, does so at the UAV's own level
+    (:func:`own_level`); a climb to the target's height stays one (k UAVs
+    arriving at a worker's ring together are not held up by it)."""
     low = min(here.z_m, target.z_m)
 
     def near(points: Iterable[Point]) -> list[Point]:
@@ -96,8 +98,8 @@ def next_leg(
         [here.z_m, target.z_m, cruise_z or -math.inf]
         + [p.z_m + clear_m for p in crossed if not above(p)]
     )
-    if layer is not None:
-        crossing = own_level(crossing, *layer)
+    if layer is not None and crossing > max(here.z_m, target.z_m) + TOLERANCE_M:
+        crossing = own_level(crossing, *layer)  # over something: at a level of its own
     if math.hypot(target.x_m - here.x_m, target.y_m - here.y_m) <= TOLERANCE_M:
         return _sidestep(here, target, people, target.z_m) or target  # straight up or down
     if here.z_m < crossing - TOLERANCE_M:

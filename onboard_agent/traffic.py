@@ -66,13 +66,21 @@ class Traffic:
         self, point: Point, radius_m: float, now_s: float, here: Point | None = None
     ) -> Sighting | None:
         """Another airborne UAV within ``radius_m`` of ``point``, if any (the
-        nearest): where it was heard, or, unheard for ``UNHEARD_S``, the
-        target it was flying to. From ``here``, also one heard nearer
+        nearest): where it was heard (unless it is leaving: flying to a
+        target farther off, so that a relief closes in as the UAV it
+        relieves climbs away), or, unheard for ``UNHEARD_S``, the target it
+        was flying to. From ``here``, also one heard nearer
         ``point`` (ties: the lower id) on its way to it (:func:`_coming`):
         of two UAVs sent to one point, the nearer goes first (chaos seed
         18: one came back to a slot as another came down to it)."""
         others = self._others(now_s)
-        near = [(s.where.distance_to(point), s) for s in others if s.unheard or not s.target]
+        targets = {s.uav_id: s.where for s in others if s.target and not s.unheard}
+        near = [
+            (s.where.distance_to(point), s)
+            for s in others
+            if s.unheard
+            or not (s.target or _leaving(s.where, targets.get(s.uav_id), point, radius_m))
+        ]
         gap, nearest = min(near, key=lambda n: n[0], default=(math.inf, None))
         if gap < radius_m:
             return nearest
@@ -126,3 +134,12 @@ def _coming(where: Point, target: Point, point: Point, radius_m: float) -> bool:
         and horizontal_distance(target, point) < radius_m
         and target.z_m > point.z_m - radius_m
     )
+
+
+def _leaving(where: Point, target: Point | None, point: Point, radius_m: float) -> bool:
+    """Whether a UAV heard at ``where`` flies away from ``point`` to a
+    target at least ``radius_m`` from it."""
+    if target is None:
+        return False
+    away = target.distance_to(point)
+    return away >= radius_m and away > where.distance_to(point)

@@ -58,3 +58,12 @@ def test_of_two_uavs_sent_to_one_point_the_nearer_goes_first(other_at, other_tar
     seen = traffic.holder(SLOT, 2.0, 0.0, here=me)
     assert (seen is not None and seen.uav_id == "uav-2") is yields
     assert traffic.holder(SLOT, 2.0, 0.0) is None  # nobody is at the point itself
+
+
+def test_a_uav_leaving_the_point_no_longer_holds_it():
+    """A relief closes in as the UAV it relieves climbs away from the slot
+    (the hand-over leaves no gap), not when it is already 2 m off."""
+    leaving = report(entry(p(0.0, 0.0, 6.5), target=p(0.0, 0.0, 11.0)))
+    assert leaving.holder(SLOT, 2.0, 0.0) is None
+    staying = report(entry(p(0.0, 0.0, 6.5), target=SLOT))
+    assert staying.holder(SLOT, 2.0, 0.0) is not None
