@@ -66,23 +66,34 @@ class Traffic:
         self, point: Point, radius_m: float, now_s: float, here: Point | None = None
     ) -> Sighting | None:
         """Another airborne UAV within ``radius_m`` of ``point``, if any (the
-        nearest): where it was heard (unless it is leaving: flying to a
-        target farther off, so that a relief closes in as the UAV it
-        relieves climbs away), or, unheard for ``UNHEARD_S``, the target it
-        was flying to. From ``here``, also one heard nearer
-        ``point`` (ties: the lower id) on its way to it (:func:`_coming`):
-        of two UAVs sent to one point, the nearer goes first (chaos seed
-        18: one came back to a slot as another came down to it)."""
+        nearest): where it was heard, or, unheard for ``UNHEARD_S``, the
+        target it was flying to. From ``here``:
+
+        - level with ``point``, one heard leaving it (flying to a target
+          farther off) no longer holds it: a relief closes in as the UAV it
+          relieves climbs away;
+        - above or below it, one heard in the column between (within
+          ``radius_m`` horizontally) holds it: chaos seed 13, a relief
+          moved over its slot as the UAV it relieved climbed out of it;
+        - one heard nearer ``point`` (ties: the lower id) on its way to it
+          (:func:`_coming`) holds it: of two UAVs sent to one point, the
+          nearer goes first (chaos seed 18)."""
         others = self._others(now_s)
         targets = {s.uav_id: s.where for s in others if s.target and not s.unheard}
-        near = [
-            (s.where.distance_to(point), s)
-            for s in others
-            if s.unheard
-            or not (s.target or _leaving(s.where, targets.get(s.uav_id), point, radius_m))
-        ]
-        gap, nearest = min(near, key=lambda n: n[0], default=(math.inf, None))
-        if gap < radius_m:
+        level = here is None or abs(here.z_m - point.z_m) <= HOVER_M
+
+        def gap(s: Sighting) -> float:
+            if s.unheard or here is None:
+                return s.where.distance_to(point)
+            if level and _leaving(s.where, targets.get(s.uav_id), point, radius_m):
+                return math.inf
+            if not level and _in_column(s.where, point, here, radius_m):
+                return horizontal_distance(s.where, point)
+            return s.where.distance_to(point)
+
+        near = [(gap(s), s) for s in others if s.unheard or not s.target]
+        nearest_gap, nearest = min(near, key=lambda n: n[0], default=(math.inf, None))
+        if nearest_gap < radius_m:
             return nearest
         if here is None:
             return None
@@ -143,3 +154,10 @@ def _leaving(where: Point, target: Point | None, point: Point, radius_m: float) 
         return False
     away = target.distance_to(point)
     return away >= radius_m and away > where.distance_to(point)
+
+
+def _in_column(where: Point, point: Point, here: Point, radius_m: float) -> bool:
+    """Whether ``where`` is within ``radius_m`` of ``point`` horizontally,
+    between its height and ``here``'s (1 m beyond either)."""
+    low, high = sorted((point.z_m, here.z_m))
+    return horizontal_distance(where, point) < radius_m and low - 1.0 < where.z_m < high + 1.0

@@ -60,10 +60,18 @@ def test_of_two_uavs_sent_to_one_point_the_nearer_goes_first(other_at, other_tar
     assert traffic.holder(SLOT, 2.0, 0.0) is None  # nobody is at the point itself
 
 
-def test_a_uav_leaving_the_point_no_longer_holds_it():
-    """A relief closes in as the UAV it relieves climbs away from the slot
-    (the hand-over leaves no gap), not when it is already 2 m off."""
+def test_a_uav_leaving_the_point_no_longer_holds_it_for_one_level_with_it():
+    """A relief level with the slot closes in as the UAV it relieves climbs
+    away from it (the hand-over leaves no gap), not once it is 2 m off.
+    From above (chaos seed 13: a relief crossing at 8.8 m over the slot as
+    the UAV it relieved climbed out of it), a UAV in the column between
+    holds it until it is above the relief."""
     leaving = report(entry(p(0.0, 0.0, 6.5), target=p(0.0, 0.0, 11.0)))
-    assert leaving.holder(SLOT, 2.0, 0.0) is None
+    assert leaving.holder(SLOT, 2.0, 0.0, here=p(3.0, 0.0, 6.0)) is None
+    assert leaving.holder(SLOT, 2.0, 0.0, here=p(-0.2, 2.5, 8.8)) is not None
+    higher = report(entry(p(0.2, -0.8, 8.5), target=p(0.2, -0.8, 13.0)))
+    assert higher.holder(SLOT, 2.0, 0.0, here=p(-0.2, 1.3, 8.8)) is not None  # in the column
+    above = report(entry(p(0.2, -0.8, 10.5), target=p(0.2, -0.8, 13.0)))
+    assert above.holder(SLOT, 2.0, 0.0, here=p(-0.2, 1.3, 8.8)) is None  # out of it
     staying = report(entry(p(0.0, 0.0, 6.5), target=SLOT))
-    assert staying.holder(SLOT, 2.0, 0.0) is not None
+    assert staying.holder(SLOT, 2.0, 0.0, here=p(3.0, 0.0, 6.0)) is not None
