@@ -45,9 +45,10 @@ MAX_LAYERS = 4
 """Places in the fleet that cruise at levels of their own; beyond it,
 places share levels (place modulo this)."""
 SIDESTEP_M = 2.0
-"""A climb (or a descent) passes no obstacle nearer than this horizontally:
-the UAV first moves level this far from it (chaos seed 13: a UAV climbed
-out of its spot into one hovering 0.8 m beside its column)."""
+"""A climb (or a descent) passes no UAV nearer than this horizontally (less
+``TOLERANCE_M``: UAVs over neighbouring spots, 2 m apart, are clear): the
+UAV first moves level this far from it (chaos seed 13: a UAV climbed out
+of its spot into one hovering 0.8 m beside its column)."""
 
 
 def ground_distance(p: Point, a: Point, b: Point) -> float:
@@ -67,6 +68,7 @@ def next_leg(
     cruise_z: float | None = None,
     columns: Iterable[Point] = (),
     layer: tuple[int, int] | None = None,
+    traffic: Iterable[Point] = (),
 ) -> Point:
     """The point to send the autopilot now on the way from ``here`` to
     ``target``; with ``cruise_z`` the flight is legged anyway and crosses
@@ -76,7 +78,10 @@ def next_leg(
     UAV's place in the fleet, the fleet's size) a flight that crosses over
     something, higher than both its ends, does so at the UAV's own level
     (:func:`own_level`); a climb to the target's height stays one (k UAVs
-    arriving at a worker's ring together are not held up by it)."""
+    arriving at a worker's ring together are not held up by it).
+    ``traffic`` (among ``people`` too) are where other UAVs are or are
+    about to be: a climb or descent first moves level clear of them
+    (:func:`_sidestep`); people beside a target are not, a drop is above one."""
     low = min(here.z_m, target.z_m)
 
     def near(points: Iterable[Point]) -> list[Point]:
@@ -101,10 +106,10 @@ def next_leg(
     if layer is not None and crossing > max(here.z_m, target.z_m) + TOLERANCE_M:
         crossing = own_level(crossing, *layer)  # over something: at a level of its own
     if math.hypot(target.x_m - here.x_m, target.y_m - here.y_m) <= TOLERANCE_M:
-        return _sidestep(here, target, people, target.z_m) or target  # straight up or down
+        return _sidestep(here, target, traffic, target.z_m) or target  # straight up or down
     if here.z_m < crossing - TOLERANCE_M:
         up = Point(x_m=here.x_m, y_m=here.y_m, z_m=crossing)
-        return _sidestep(here, target, people, crossing) or up
+        return _sidestep(here, target, traffic, crossing) or up
     return Point(x_m=target.x_m, y_m=target.y_m, z_m=crossing)
 
 
@@ -117,7 +122,9 @@ def _sidestep(here: Point, target: Point, obstacles: Iterable[Point], to_z: floa
     up = to_z > here.z_m
     low, high = (here.z_m, to_z + 1.0) if up else (to_z - 1.0, here.z_m)
     blocking = [
-        p for p in obstacles if ground_distance(p, here, here) < SIDESTEP_M and low < p.z_m < high
+        p
+        for p in obstacles
+        if ground_distance(p, here, here) < SIDESTEP_M - TOLERANCE_M and low < p.z_m < high
     ]
     if not blocking:
         return None

@@ -165,15 +165,16 @@ class GoNear(AgentBehaviour):
         if self._yielding(point, now):
             return Status.RUNNING
         clear_m = ctx.surroundings.site.safety.people_clearance_m + config.route_margin_m
+        traffic = ctx.traffic.obstacles(ctx.link_clock())
         obstacles = (
-            ctx.surroundings.people()
-            + ctx.spots.raised_spots(ctx.surroundings.site)
-            + ctx.traffic.obstacles(ctx.link_clock())
+            ctx.surroundings.people() + ctx.spots.raised_spots(ctx.surroundings.site) + traffic
         )
         columns = ctx.spots.busy_columns(ctx.surroundings.site, config.approach_alt_m)
         cruise_z = self.target.cruise_z(ctx)
         layer = ctx.spots.layer
-        leg = route.next_leg(vehicle.position, point, obstacles, clear_m, cruise_z, columns, layer)
+        leg = route.next_leg(
+            vehicle.position, point, obstacles, clear_m, cruise_z, columns, layer, traffic
+        )
         moved = self._sent is None or self._sent.distance_to(leg) > config.follow_threshold_m
         if moved or now - self._sent_at >= config.goto_resend_s:
             ctx.goto(leg)

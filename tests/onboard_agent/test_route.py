@@ -52,18 +52,27 @@ def test_a_uav_hovering_right_above_is_left_level_never_climbed_into():
 def test_a_climb_or_a_descent_moves_level_first_clear_of_one_hovering_beside():
     """Chaos seed 13: a UAV climbing out of its spot to cross over a far
     waypoint rose into one hovering 0.8 m beside its column. It moves level
-    to 2 m from that one first, then climbs (and crosses over it too)."""
+    to 2 m from that one first, then climbs (and crosses over it too). A
+    person beside the column is no reason (a drop is above one; seed 16:
+    UAVs sidestepping W3 beside C2 never landed and fell)."""
     here, target = point(1, 20, 6), point(5, -3, 17)
     beside = point(1.7, 20.4, 11.8)
     obstacles = [beside, point(5, -3, 17)]  # the far waypoint raises the crossing
-    first = next_leg(here, target, obstacles, CLEAR_M)
+    first = next_leg(here, target, obstacles, CLEAR_M, traffic=[beside])
     assert first.z_m == here.z_m  # level
     assert ground_distance(beside, first, first) >= SIDESTEP_M
-    up = next_leg(first, target, obstacles, CLEAR_M)
+    up = next_leg(first, target, obstacles, CLEAR_M, traffic=[beside])
     assert (up.x_m, up.y_m) == (first.x_m, first.y_m) and up.z_m >= beside.z_m + CLEAR_M
     # straight down onto a target: first clear of one hovering on the way
-    down = next_leg(point(0, 0, 12), point(0, 0, 6), [point(0.5, 0, 9)], CLEAR_M)
-    assert down.z_m == 12 and ground_distance(point(0.5, 0, 9), down, down) >= SIDESTEP_M
+    hovering = point(0.5, 0, 9)
+    down = next_leg(point(0, 0, 12), point(0, 0, 6), [hovering], CLEAR_M, traffic=[hovering])
+    assert down.z_m == 12 and ground_distance(hovering, down, down) >= SIDESTEP_M
+    person = point(1.5, 0, 3)  # a worker beside a spot (W3 stands 2 m from one of C2's)
+    assert next_leg(point(0, 0, 9), point(0, 0, 3), [person], CLEAR_M) == point(0, 0, 3)
+    neighbour = point(2, 0, 3)  # above the next spot, 2 m off: clear
+    assert next_leg(point(0, 0, 9), point(0, 0, 3), [], CLEAR_M, traffic=[neighbour]) == point(
+        0, 0, 3
+    )
 
 
 def test_uavs_at_different_places_cross_at_levels_2_m_apart():
