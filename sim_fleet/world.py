@@ -92,13 +92,15 @@ class World:
         self._pending_s = max(0.0, self._pending_s - n * h)
         for _ in range(n):
             self.time_s += h
+            seen = len(self.safety.violations)
             for v in self.vehicles.values():
                 before = v.state
                 v.step(h, self.time_s)
                 if v.state is not before:
                     self.safety.transition(v, before, self.time_s)
+                    if v.state is FlightState.CRASHED:
+                        self._log_track("crash", (v.id,))
             self.recorder.step(self.vehicles.values(), self.time_s)
-            seen = len(self.safety.violations)
             self.safety.check(self.vehicles.values(), self.workers, self.time_s)
             self._log_tracks(self.safety.violations[seen:])
             self.watch.step(self.vehicles.values(), self.workers, h)
@@ -108,9 +110,12 @@ class World:
         """Log how the two vehicles of each new separation violation came together."""
         for v in violations:
             if v.kind == SEPARATION:
-                pair = (v.vehicle_id, v.detail.split()[0])
-                lines = "\n".join(self.recorder.track(pair))
-                log.warning("separation %s/%s at %.1f s, last seconds:\n%s", *pair, v.time_s, lines)
+                self._log_track(SEPARATION, (v.vehicle_id, v.detail.split()[0]))
+
+    def _log_track(self, what: str, ids: tuple[str, ...]) -> None:
+        """Log the flight recorder's last seconds of ``ids`` (a crash, a near miss)."""
+        lines = "\n".join(self.recorder.track(ids))
+        log.warning("%s %s at %.1f s, last seconds:\n%s", what, "/".join(ids), self.time_s, lines)
 
     def _recharge(self, dt_s: float) -> None:
         dock_r = self.rules.dock_radius_m

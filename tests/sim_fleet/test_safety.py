@@ -156,6 +156,18 @@ def test_a_separation_is_logged_with_how_the_two_came_together(caplog):
     assert "-> (0.6, 0.0, 10.0) flying" in track[-1]  # where u2 was sent
 
 
+def test_a_crash_is_logged_with_how_the_vehicle_got_there(caplog):
+    w = world(n=1, homes=("S1",))
+    u1 = w.vehicle("u1")
+    airborne(w, u1, 10.0)
+    with caplog.at_level(logging.WARNING, logger="sim_fleet.world"):
+        u1.battery.set_soc(0.0)  # empty: the motors stop
+        w.step(20.0)
+    assert u1.state is FlightState.CRASHED
+    [record] = [r for r in caplog.records if "crash u1" in r.getMessage()]
+    assert len(record.getMessage().splitlines()) > 5
+
+
 def test_safety_distances_come_from_the_scenario():
     sc = scenario(n=2, homes=("S1", "S2"))
     assert sc.safety == SafetyRules()  # defaults as proto.Safety
