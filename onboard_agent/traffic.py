@@ -112,8 +112,23 @@ class Traffic:
         target, the targets they fly to, and where those unheard for
         ``UNHEARD_S`` were heard. Chaos seeds 14 and 17: a UAV crossing
         beside a worker at the height that clears people passed 0.92 m
-        from one arriving at (or watching from) its slot beside that worker."""
-        return [s.where for s in self._others(now_s) if s.target or s.unheard or s.hovering]
+        from one arriving at (or watching from) its slot beside that worker.
+
+        The point a heard UAV climbs to counts only for UAVs after it in id
+        order: two UAVs climbing side by side, each over the other's climb
+        target, went on raising their crossings to 695 m (chaos seed 12)."""
+        others = self._others(now_s)
+        heard = {s.uav_id: s.where for s in others if not s.target}
+
+        def climbing(s: Sighting) -> bool:
+            where = heard.get(s.uav_id)
+            return where is not None and s.where.z_m > where.z_m + HOVER_M
+
+        return [
+            s.where
+            for s in others
+            if s.unheard or s.hovering or (s.target and (not climbing(s) or s.uav_id < self.uav_id))
+        ]
 
     def _others(self, now_s: float) -> list[Sighting]:
         """Where the other airborne UAVs of the report may be: where each

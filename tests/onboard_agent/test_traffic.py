@@ -3,6 +3,7 @@ unheard whose target it was, and, of two sent to it, the nearer."""
 
 from __future__ import annotations
 
+import msgspec
 import pytest
 
 from onboard_agent.traffic import Traffic
@@ -75,3 +76,21 @@ def test_a_uav_leaving_the_point_no_longer_holds_it_for_one_level_with_it():
     assert above.holder(SLOT, 2.0, 0.0, here=p(-0.2, 1.3, 8.8)) is None  # out of it
     staying = report(entry(p(0.0, 0.0, 6.5), target=SLOT))
     assert staying.holder(SLOT, 2.0, 0.0, here=p(3.0, 0.0, 6.0)) is not None
+
+
+def test_a_climb_target_is_an_obstacle_for_uavs_after_the_climber_only():
+    """Chaos seed 12: uav-1 and uav-2 climbed side by side out of C2, each
+    crossing over the other's climb target, up to 150 m. The one later in
+    id order crosses over the other's climb; the earlier one ignores it."""
+    climb = TrafficEntry(
+        uav_id="uav-2", position=p(3.0, 20.0, 5.0), airborne=True, age_s=0.2, target=p(3, 20, 13)
+    )
+    earlier = Traffic("uav-1")
+    earlier.update(TrafficReport(uavs=[climb]), 0.0)
+    assert p(3, 20, 13) not in earlier.obstacles(0.0)
+    later = Traffic("uav-3")
+    later.update(TrafficReport(uavs=[climb]), 0.0)
+    assert p(3, 20, 13) in later.obstacles(0.0)
+    level = msgspec.structs.replace(climb, target=p(9, 20, 5))  # on its way, level: counts
+    earlier.update(TrafficReport(uavs=[level]), 0.0)
+    assert p(9, 20, 5) in earlier.obstacles(0.0)
