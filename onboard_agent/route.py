@@ -75,12 +75,10 @@ def next_leg(
     at that height at least (a height of the UAV's own, clear of others).
     ``columns`` are crossed above like ``people``, even beside the target
     (the spots where other UAVs land and take off). With ``layer`` (the
-    UAV's place in the fleet, the fleet's size) a flight that crosses
-    higher than its target does so at the UAV's own level
-    (:func:`own_level`), however high it is now (chaos seed 14: two UAVs
-    re-routed mid-climb flew level at 11.5 and 11.8 m into each other); a
-    climb to the target's height stays one (k UAVs arriving at a worker's
-    ring together are not held up by it).
+    UAV's place in the fleet, the fleet's size) a flight that crosses over
+    something, higher than both its ends, does so at the UAV's own level
+    (:func:`own_level`); a climb to the target's height stays one (k UAVs
+    arriving at a worker's ring together are not held up by it).
     ``traffic`` (among ``people`` too) are where other UAVs are or are
     about to be: a climb or descent first moves level clear of them
     (:func:`_sidestep`); people beside a target are not, a drop is above one."""
@@ -105,8 +103,8 @@ def next_leg(
         [here.z_m, target.z_m, cruise_z or -math.inf]
         + [p.z_m + clear_m for p in crossed if not above(p)]
     )
-    if layer is not None and crossing > target.z_m + TOLERANCE_M:
-        crossing = own_level(crossing, *layer)  # above the target: at a level of its own
+    if layer is not None and crossing > max(here.z_m, target.z_m) + TOLERANCE_M:
+        crossing = own_level(crossing, *layer)  # over something: at a level of its own
     if math.hypot(target.x_m - here.x_m, target.y_m - here.y_m) <= TOLERANCE_M:
         return _sidestep(here, target, traffic, target.z_m) or target  # straight up or down
     if here.z_m < crossing - TOLERANCE_M:
