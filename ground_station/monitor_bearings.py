@@ -141,7 +141,8 @@ def moved_off(
     bearings = record_bearings(record)
     taken = bearings + _worker_slots(action.worker_id, in_force, record.action_id)
     starts = [i * STEP_DEG for i in range(round(360.0 / STEP_DEG))]
-    best = _best(starts, lambda b: [b], taken, lambda b: _clearance(action, _workers(site), b))
+    workers = _workers(site)
+    best = _best(starts, lambda b: [b], taken, lambda b: _clearance(action, workers, b))
     moved = {**record.slot_bearings_deg, slot: best}
     return msgspec.structs.replace(record, slot_bearings_deg=moved)
 

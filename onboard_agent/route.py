@@ -117,8 +117,8 @@ def _sidestep(here: Point, target: Point, obstacles: Iterable[Point], to_z: floa
     """Where to move level first, if going up or down at ``here`` to
     ``to_z`` would pass within ``SIDESTEP_M`` (horizontally) of an obstacle
     on the way (from the UAV's height to 1 m past ``to_z``): ``SIDESTEP_M``
-    from the nearest such, away
-    from it (right below or above it: towards the target)."""
+    from the nearest such, away from it (right below or above it: towards
+    the target)."""
     up = to_z > here.z_m
     low, high = (here.z_m, to_z + 1.0) if up else (to_z - 1.0, here.z_m)
     blocking = [

@@ -57,9 +57,9 @@ class TrafficEntry(Record, frozen=True, kw_only=True):
 
 
 class Traffic(Message, frozen=True, kw_only=True):
-    """Where the fleet's UAVs are, from the ground station twice a mission second (at most
-    20 times a wall second)
-    on ``gs/traffic``: agents keep clear of points another UAV hovers at.
+    """Where the fleet's UAVs are, from the ground station on ``gs/traffic``
+    twice a mission second (at most 20 times a wall second): agents keep
+    clear of points another UAV hovers at.
 
     It also announces the ground station: ``generation`` (one id per
     ground-station run) and ``epoch``, the newest plan epoch it has issued.
