@@ -99,12 +99,14 @@ def next_leg(
         return target
     beside_target = [p for p in near_people if ground_distance(p, target, target) < clear_m]
     crossed = [p for p in near_people if p not in beside_target] + near_columns
-    crossing = max(
-        [here.z_m, target.z_m, cruise_z or -math.inf]
-        + [p.z_m + clear_m for p in crossed if not above(p)]
+    needed = max(
+        [target.z_m, cruise_z or -math.inf] + [p.z_m + clear_m for p in crossed if not above(p)]
     )
+    crossing = max(here.z_m, needed)
     if layer is not None and crossing > max(here.z_m, target.z_m) + TOLERANCE_M:
         crossing = own_level(crossing, *layer)  # over something: at a level of its own
+    elif layer is not None and here.z_m > needed + TOLERANCE_M:
+        crossing = nearest_level(here.z_m, needed, *layer)  # higher than it needs: the same
     if math.hypot(target.x_m - here.x_m, target.y_m - here.y_m) <= TOLERANCE_M:
         return _sidestep(here, target, traffic, target.z_m) or target  # straight up or down
     if here.z_m < crossing - TOLERANCE_M:
@@ -136,6 +138,17 @@ def _sidestep(here: Point, target: Point, obstacles: Iterable[Point], to_z: floa
         dx, dy = 1.0, 0.0
     scale = (SIDESTEP_M + TOLERANCE_M) / math.hypot(dx, dy)
     return Point(x_m=p.x_m + dx * scale, y_m=p.y_m + dy * scale, z_m=here.z_m)
+
+
+def nearest_level(z_m: float, at_least_m: float, place: int, fleet_size: int) -> float:
+    """The cruise level of the UAV at ``place`` at or below ``z_m`` (within
+    ``TOLERANCE_M``: its own) and not below ``at_least_m``; ``z_m`` if there
+    is none. Where a UAV higher than its flight needs (re-routed mid-climb,
+    flying on from a hold) goes across, on its way down (chaos seed 14: two
+    re-routed mid-climb flew level at 11.5 and 11.8 m into each other)."""
+    layers = max(1, min(fleet_size, MAX_LAYERS))
+    below = own_level(z_m - LEVEL_STEP_M * layers + TOLERANCE_M, place, fleet_size)
+    return below if below >= at_least_m else z_m
 
 
 def own_level(z_m: float, place: int, fleet_size: int) -> float:

@@ -11,7 +11,13 @@ import msgspec
 import pytest
 
 from onboard_agent import AgentConfig
-from onboard_agent.route import SIDESTEP_M, ground_distance, next_leg, own_level
+from onboard_agent.route import (
+    SIDESTEP_M,
+    ground_distance,
+    nearest_level,
+    next_leg,
+    own_level,
+)
 from onboard_agent.spots import Spots
 from proto.telemetry import FlightState
 from tests.onboard_agent.helpers import SCENARIO, Rig, on_a_spot, point
@@ -88,6 +94,24 @@ def test_uavs_at_different_places_cross_at_levels_2_m_apart():
     here, target = point(0, 0, 5), point(20, 0, 5)
     legs = [next_leg(here, target, [point(10, 0, 3)], CLEAR_M, layer=(p, 3)) for p in range(3)]
     assert [leg.z_m for leg in legs] == [own_level(3 + CLEAR_M, p, 3) for p in range(3)]
+
+
+def test_a_uav_higher_than_its_flight_needs_crosses_at_a_level_of_its_own_below():
+    """Chaos seed 14: two UAVs re-routed mid-climb flew level at 11.5 and
+    11.8 m (the heights they had reached) into each other. One higher than
+    its flight needs goes across at the level of its own next below, never
+    below what the flight needs (then where it is); at a level it stays."""
+    target, person = point(20, 0, 3), point(10, 0, 3)  # legged: crosses over 3 + CLEAR_M
+    legs = [
+        next_leg(point(0, 0, z), target, [person], CLEAR_M, layer=(p, 3))
+        for p, z in ((0, 11.5), (1, 11.8), (2, 11.8))
+    ]
+    assert [leg.z_m for leg in legs] == [11.0, 7.0, 9.0]  # levels 5/11, 7/13, 9/15
+    assert nearest_level(11.5, 10.0, 2, 3) == 11.5  # 9 is too low for this flight
+    for z in (9.0, 9.2, 8.8, 9.35):  # at (or just off) its level: that level
+        assert nearest_level(z, 3.0, 2, 3) == 9.0
+    across = next_leg(point(0, 0, 9.2), target, [person], CLEAR_M, layer=(2, 3))
+    assert across == point(20, 0, 9.0)
 
 
 def test_a_target_placed_beside_a_person_is_reached_from_above():
