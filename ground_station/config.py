@@ -3,15 +3,16 @@
 from __future__ import annotations
 
 import dataclasses
-import os
 
-MIN_TRAFFIC_PERIOD_S = 0.05
-"""Traffic reports at most 20 times a wall second, whatever the speed-up."""
+from linecrew.clock import wall_period_s
+from linecrew.settings import EnvSettings
 
 
 @dataclasses.dataclass(frozen=True, kw_only=True)
-class GsConfig:
+class GsConfig(EnvSettings):
     """Ground-station settings (flags override ``LINECREW_GS_*`` variables)."""
+
+    ENV_PREFIX = "LINECREW_GS_"
 
     scenario: str = "paper"  # shipped scenario name or a scenario file
     db_path: str = "linecrew-gs.db"  # the SQLite store (created if missing)
@@ -29,19 +30,5 @@ class GsConfig:
     traffic_period_s: float = 0.5  # wall s between two traffic reports (see ``traffic_period``)
 
     def traffic_period(self, speedup: float) -> float:
-        """Wall seconds between traffic reports under ``speedup``: the same
-        mission seconds as at x1 (UAVs move ``speedup`` times as far between
-        two reports), never below ``MIN_TRAFFIC_PERIOD_S``."""
-        return max(MIN_TRAFFIC_PERIOD_S, self.traffic_period_s / max(speedup, 1.0))
-
-    @classmethod
-    def from_env(cls, **overrides: object) -> GsConfig:
-        """Defaults, then environment, then ``overrides`` (``None`` ignored)."""
-        values: dict[str, object] = {}
-        for field in dataclasses.fields(cls):
-            raw = os.environ.get(f"LINECREW_GS_{field.name.upper()}")
-            if raw is not None:
-                convert = {"float": float, "int": lambda v: int(float(v))}.get(field.type, str)
-                values[field.name] = convert(raw)
-        values.update({k: v for k, v in overrides.items() if v is not None})
-        return cls(**values)  # type: ignore[arg-type]
+        """Wall seconds between traffic reports under ``speedup`` (:func:`wall_period_s`)."""
+        return wall_period_s(self.traffic_period_s, speedup)

@@ -32,17 +32,17 @@ def main(argv: list[str] | None = None) -> int:
     )
     args = parser.parse_args(argv)
     bus_config = start(args, "ground-station")
-    config = GsConfig.from_env(
-        scenario=args.scenario,
-        db_path=args.db_path,
-        gs_id=args.gs_id,
-        link_timeout_s=args.link_timeout_s,
-    )
     shutdown = Shutdown().install()
     try:
+        config = GsConfig.from_env(
+            scenario=args.scenario,
+            db_path=args.db_path,
+            gs_id=args.gs_id,
+            link_timeout_s=args.link_timeout_s,
+        )
         scenario = load(config.scenario, site=args.site)
         bus = Bus.open(bus_config, should_stop=shutdown.is_set)
-    except (ScenarioError, Unavailable) as exc:
+    except (ValueError, ScenarioError, Unavailable) as exc:
         log.error("ground station cannot start: %s", exc)
         return 1
     with bus:

@@ -20,6 +20,9 @@ import time
 from collections.abc import Callable
 
 OFFSET_ENV = "LINECREW_CLOCK_OFFSET_S"
+MIN_WALL_PERIOD_S = 0.05
+"""A periodic message keeps its mission-time rate under a speed-up, but is
+never sent more than 20 times a wall second for it."""
 
 
 def mission_clock(speedup: float = 1.0) -> Callable[[], float]:
@@ -43,6 +46,14 @@ def clock_offset_s() -> float:
     if not math.isfinite(offset):
         raise ValueError(f"{OFFSET_ENV} must be finite, got {raw!r}")
     return offset
+
+
+def wall_period_s(period_s: float, speedup: float) -> float:
+    """Wall seconds between two messages sent every ``period_s`` at x1, so
+    that under ``speedup`` they stay that many mission seconds apart (others
+    steer by them: at x10 a 0.5 s report would be 10 m of flight old); never
+    below :data:`MIN_WALL_PERIOD_S` for it, never longer than ``period_s``."""
+    return min(period_s, max(MIN_WALL_PERIOD_S, period_s / max(speedup, 1.0)))
 
 
 def time_of_day(mission_s: float) -> str:

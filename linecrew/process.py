@@ -1,11 +1,12 @@
 """What every long-running linecrew process shares: common command-line
-flags, the bus settings they imply, and shutdown on SIGINT/SIGTERM."""
+flags, the run and bus settings they imply, and shutdown on SIGINT/SIGTERM."""
 
 from __future__ import annotations
 
 import argparse
 import asyncio
 import contextlib
+import dataclasses
 import logging
 import os
 import signal
@@ -13,15 +14,37 @@ import threading
 
 from linecrew.bus import BusConfig
 from linecrew.logs import configure_logging
+from linecrew.settings import EnvSettings
 
 log = logging.getLogger(__name__)
+
+DEFAULT_SITE = "default"
+"""The site id of a process with neither a scenario nor ``--site`` /
+``LINECREW_SITE`` (the id of the shipped scenarios)."""
+
+
+@dataclasses.dataclass(frozen=True, kw_only=True)
+class RunSettings(EnvSettings):
+    """What every process of a run shares (flags override ``LINECREW_*``)."""
+
+    ENV_PREFIX = "LINECREW_"
+
+    site: str | None = None  # key space root; None: the scenario's (else DEFAULT_SITE)
+    speedup: float = 1.0  # mission seconds per wall second
+
+
+def site_id(site: str | None = None) -> str:
+    """The site of a process without a scenario: ``site`` (its ``--site``),
+    else ``LINECREW_SITE``, else :data:`DEFAULT_SITE`. Raises ``ValueError``."""
+    return RunSettings.from_env(site=site).site or DEFAULT_SITE
 
 
 def common_parser(prog: str, description: str) -> argparse.ArgumentParser:
     """An argument parser with the flags every process takes."""
     parser = argparse.ArgumentParser(prog=prog, description=description)
     parser.add_argument(
-        "--site", help="site id (key space root); must match the scenario's if both are given"
+        "--site",
+        help="site id (key space root; else LINECREW_SITE); must match the scenario's",
     )
     parser.add_argument(
         "--connect", action="append", help="zenoh endpoint to connect to (repeatable)"
@@ -32,25 +55,34 @@ def common_parser(prog: str, description: str) -> argparse.ArgumentParser:
     parser.add_argument(
         "--speedup",
         type=float,
-        default=float(os.environ.get("LINECREW_SPEEDUP", "1")),
-        help="mission seconds per wall second; the same for every process of a run",
+        help="mission seconds per wall second (else LINECREW_SPEEDUP, 1); "
+        "the same for every process of a run",
     )
     parser.add_argument("--log-level", default="info", help="debug, info, warning, error")
     parser.add_argument("--log-format", choices=["plain", "json"], default="plain")
     return parser
 
 
-def start(args: argparse.Namespace, process: str, mode: str = "client") -> BusConfig:
-    """Configure logging for ``process`` and return its bus settings
-    (flags override ``LINECREW_ZENOH_*`` environment variables)."""
+def start(args: argparse.Namespace, process: str, mode: str | None = None) -> BusConfig:
+    """Configure logging for ``process``, resolve ``args.site`` and
+    ``args.speedup`` (:class:`RunSettings`) and return its bus settings
+    (``mode`` forced, else ``LINECREW_ZENOH_MODE`` or client); flags override
+    ``LINECREW_*`` variables. Exits 2 on a bad variable."""
     configure_logging(args.log_level, args.log_format, process)
-    return BusConfig.from_env(
-        mode=mode,
-        connect=tuple(args.connect) if args.connect else None,
-        listen=tuple(args.listen) if args.listen else None,
-        config_file=args.zenoh_config,
-        lease_ms=args.lease_ms,
-    )
+    try:
+        run = RunSettings.from_env(site=args.site, speedup=args.speedup)
+        bus = BusConfig.from_env(
+            mode=mode,
+            connect=tuple(args.connect) if args.connect else None,
+            listen=tuple(args.listen) if args.listen else None,
+            config_file=args.zenoh_config,
+            lease_ms=args.lease_ms,
+        )
+    except ValueError as exc:
+        log.error("%s cannot start: %s", process, exc)
+        raise SystemExit(2) from None
+    args.site, args.speedup = run.site, run.speedup
+    return bus
 
 
 WAIT_SLICE_S = 0.2

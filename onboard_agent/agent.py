@@ -63,7 +63,7 @@ class Agent:
             config=config,
             autopilot=autopilot,
             mission=Mission(uav_id, scenario.site, wall),
-            surroundings=Surroundings(scenario.site),
+            surroundings=Surroundings(scenario.site, wall),
             spots=Spots(uav_id, scenario, link_clock),
             traffic=Traffic(uav_id),
             energy=energy,

@@ -2,23 +2,23 @@
 
 Values come from defaults, then ``LINECREW_AGENT_*`` environment variables
 (the upper-cased field name, e.g. ``LINECREW_AGENT_TICK_HZ=5``), then
-command-line overrides.
+command-line overrides, read as every process reads its settings
+(:mod:`linecrew.settings`).
 """
 
 from __future__ import annotations
 
 import dataclasses
-import os
-from collections.abc import Callable, Mapping
 
-ENV_PREFIX = "LINECREW_AGENT_"
-MAX_TELEMETRY_HZ = 20.0
-"""Telemetry at most this often (wall), whatever the speed-up."""
+from linecrew.clock import wall_period_s
+from linecrew.settings import EnvSettings
 
 
 @dataclasses.dataclass(frozen=True, kw_only=True)
-class AgentConfig:
+class AgentConfig(EnvSettings):
     """Behaviour-tree, emergency and autopilot-link settings of one agent."""
+
+    ENV_PREFIX = "LINECREW_AGENT_"
 
     tick_hz: float = 10.0  # behaviour-tree ticks per second
     telemetry_hz: float = 5.0  # Telemetry messages per second
@@ -59,33 +59,11 @@ class AgentConfig:
     autopilot_component: int = 1  # its component id (MAV_COMP_ID_AUTOPILOT1)
     plan_query_timeout_s: float = 2.0  # resync query to the ground station
 
-    @classmethod
-    def from_env(cls, env: Mapping[str, str] | None = None, **overrides: object) -> AgentConfig:
-        """Defaults, then ``LINECREW_AGENT_*`` variables, then ``overrides``
-        (``None`` values ignored). Raises ``ValueError`` for a bad value."""
-        env = os.environ if env is None else env
-        values: dict[str, object] = {}
-        for field in dataclasses.fields(cls):
-            raw = env.get(ENV_PREFIX + field.name.upper())
-            if raw is not None:
-                kind: Callable[[str], object] = int if field.type in ("int", int) else float
-                if field.type in ("bool", bool):
-                    kind = _boolean
-                try:
-                    values[field.name] = kind(raw)
-                except ValueError as exc:
-                    raise ValueError(f"{ENV_PREFIX}{field.name.upper()}={raw!r}: {exc}") from None
-        values.update({k: v for k, v in overrides.items() if v is not None})
-        config = cls(**values)  # type: ignore[arg-type]
-        config.check()
-        return config
-
     def at_speedup(self, speedup: float) -> AgentConfig:
         """These settings for a mission clock ``speedup`` times real time:
-        telemetry as often in mission seconds as at x1 (other UAVs steer
-        clear of where it says this one is), at most ``MAX_TELEMETRY_HZ``."""
-        hz = min(MAX_TELEMETRY_HZ, self.telemetry_hz * max(speedup, 1.0))
-        return dataclasses.replace(self, telemetry_hz=max(hz, self.telemetry_hz))
+        telemetry as often in mission seconds as at x1 (:func:`wall_period_s`)."""
+        hz = 1.0 / wall_period_s(1.0 / self.telemetry_hz, speedup)
+        return dataclasses.replace(self, telemetry_hz=hz)
 
     def check(self) -> None:
         """Raise ``ValueError`` for settings that cannot work."""
@@ -101,12 +79,3 @@ class AgentConfig:
             raise ValueError("command_retries must be >= 0")
         if self.arm_attempts < 1 or self.retry_backoff_s <= 0 or self.ready_timeout_s <= 0:
             raise ValueError("arm_attempts, retry_backoff_s and ready_timeout_s must be positive")
-
-
-def _boolean(raw: str) -> bool:
-    text = raw.strip().lower()
-    if text in ("1", "true", "yes", "on"):
-        return True
-    if text in ("0", "false", "no", "off", ""):
-        return False
-    raise ValueError(f"not a boolean: {raw!r}")

@@ -22,7 +22,7 @@ class Surroundings:
 
     def __init__(self, site: Site, clock: Callable[[], float] = time.time) -> None:
         self.site = site
-        self.clock = clock  # real time, as poses are stamped
+        self.clock = clock  # the mission clock, as poses are stamped
         self._poses: dict[str, HumanPose] = {}
         self.refused = 0  # poses stamped beyond POSE_FUTURE_S ahead
 

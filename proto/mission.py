@@ -24,7 +24,7 @@ class ActionBase(Record, frozen=True, kw_only=True):
     """Fields every action has.
 
     ``priority`` is the weight of the FCFS queue (higher first);
-    ``release_s`` is the earliest start (UNIX seconds, 0 = now).
+    ``release_s`` is the earliest start (mission seconds, see :mod:`proto.telemetry`; 0 = now).
     """
 
     priority: Priority = 1.0

@@ -2,8 +2,8 @@
 
 A :class:`Plan` holds the ordered tasks of one UAV under a monotonically
 increasing ``epoch``; an agent ignores any plan older than the one it holds.
-Every task carries the planner's estimates (``start_s``/``end_s`` in UNIX
-seconds, ``energy_after_wh``) so agents can judge "battery enough".
+Every task carries the planner's estimates (``start_s``/``end_s`` in mission
+seconds (see :mod:`proto.telemetry`), ``energy_after_wh``) so agents can judge "battery enough".
 """
 
 from __future__ import annotations
@@ -98,7 +98,7 @@ class RechargeTask(TaskBase, frozen=True, kw_only=True, tag="recharge"):
 
 
 class WaitTask(TaskBase, frozen=True, kw_only=True, tag="wait"):
-    """Hold (on the pad if landed) until ``until_s`` (UNIX seconds)."""
+    """Hold (on the pad if landed) until ``until_s`` (mission seconds)."""
 
     until_s: Finite
 

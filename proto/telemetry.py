@@ -1,5 +1,7 @@
 """What agents and the human tracker report: telemetry, agent status,
-task outcomes and human poses. Times are UNIX seconds (``stamp_s``).
+task outcomes and human poses. Times (``stamp_s``) are mission seconds:
+UNIX seconds in the field, UNIX seconds times K in a simulation run at
+``--speedup K`` (:mod:`linecrew.clock`), for every sender alike.
 """
 
 from __future__ import annotations
@@ -147,8 +149,8 @@ is refused (a forged one would otherwise outrank every real pose)."""
 
 class HumanPose(Message, frozen=True, kw_only=True):
     """A worker's position from the human tracker, on ``human/{id}/pose``.
-    ``stamp_s`` is real UNIX time (the tracker is a device in the world, not
-    on the mission clock)."""
+    ``stamp_s`` is on the mission clock, as telemetry is (a simulated
+    tracker lives in the sped-up world)."""
 
     worker_id: Id
     stamp_s: Finite

@@ -7,6 +7,7 @@ import sys
 
 from linecrew.bus import Bus, BusConfig
 from linecrew.fault_kinds import add_fault_arguments, fault_from_args
+from linecrew.process import site_id
 from proto import errors
 from proto.keys import KeySpace
 from proto.sim import FaultApplied
@@ -16,7 +17,7 @@ def main(argv: list[str] | None = None) -> int:
     """Send one fault; print the acknowledgement; exit 1 on an error reply."""
     parser = argparse.ArgumentParser(prog="linecrew sim fault", description=__doc__)
     parser.add_argument("--connect", default=None, help="zenoh router endpoint")
-    parser.add_argument("--site", default="default")
+    parser.add_argument("--site", help="site id (else LINECREW_SITE, else default)")
     parser.add_argument("--timeout", type=float, default=5.0)
     add_fault_arguments(parser)
     args = parser.parse_args(argv)
@@ -24,10 +25,14 @@ def main(argv: list[str] | None = None) -> int:
         fault = fault_from_args(args)
     except ValueError as exc:
         parser.error(str(exc))
-    config = BusConfig.from_env(connect=(args.connect,) if args.connect else None)
+    try:
+        keys = KeySpace(site_id(args.site))
+        config = BusConfig.from_env(connect=(args.connect,) if args.connect else None)
+    except (ValueError, errors.LinecrewError) as exc:
+        parser.error(str(exc))
     try:
         with Bus.open(config, wait_s=args.timeout) as bus:
-            reply = bus.query(KeySpace(args.site).sim("fault"), fault, FaultApplied, args.timeout)
+            reply = bus.query(keys.sim("fault"), fault, FaultApplied, args.timeout)
     except errors.LinecrewError as exc:
         print(f"linecrew sim fault: {exc.code}: {exc}", file=sys.stderr)
         return 1

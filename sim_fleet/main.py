@@ -14,6 +14,7 @@ import logging
 import sys
 
 from linecrew.bus import Bus
+from linecrew.clock import mission_clock
 from linecrew.mavlink_keys import SigningKeyError, key_path, load_key
 from linecrew.process import Shutdown, common_parser, start
 from linecrew.scenarios import ScenarioError, load
@@ -50,7 +51,7 @@ async def serve(
     log.info(
         "simulating %d UAVs at x%g", len(fleet.endpoints), speedup, extra={"ports": fleet.ports}
     )
-    tracker = HumanTracker(scenario.site, world, bus)
+    tracker = HumanTracker(scenario.site, world, bus, mission_clock(speedup))
     sites = fleet.world.scenario.stations
     control = SpotControl(
         {s.id: s.spot_points for s in sites},

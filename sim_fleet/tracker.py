@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import asyncio
 import time
+from collections.abc import Callable
 
 from linecrew.bus import Bus
 from proto.geo import Point, SiteFrame
@@ -16,10 +17,14 @@ from sim_fleet.world import World
 
 
 class HumanTracker:
-    """Publishes worker poses from the simulated world."""
+    """Publishes worker poses from the simulated world, stamped on the
+    mission clock (``clock``) as telemetry is."""
 
-    def __init__(self, site: Site, world: World, bus: Bus) -> None:
+    def __init__(
+        self, site: Site, world: World, bus: Bus, clock: Callable[[], float] = time.time
+    ) -> None:
         self.site = site
+        self.clock = clock
         self.world = world
         self.bus = bus
         self.keys = KeySpace(site.id)
@@ -37,7 +42,7 @@ class HumanTracker:
                 position = Point(x_m=x, y_m=y, z_m=z)
             pose = HumanPose(
                 worker_id=worker.id,
-                stamp_s=time.time(),
+                stamp_s=self.clock(),
                 position=position,
                 geo=self.frame.to_geodetic(position),
             )

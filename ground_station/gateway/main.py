@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import asyncio
+import dataclasses
 import logging
 import sys
 
@@ -11,14 +12,10 @@ import uvicorn
 from ground_station.gateway.app import create_app
 from ground_station.gateway.gestures import Vocabulary
 from ground_station.gateway.rpc import GsClient
-from ground_station.gateway.settings import (
-    DevTokenRefused,
-    GatewaySettings,
-    check_token,
-    resolve_token,
-)
+from ground_station.gateway.settings import GatewaySettings, check_token, resolve_token
 from ground_station.gateway.workers import WorkerPoses
 from linecrew.bus import Bus
+from linecrew.clock import mission_clock
 from linecrew.process import common_parser, start
 from linecrew.scenarios import ScenarioError, load
 from proto.errors import Unavailable
@@ -35,13 +32,13 @@ long before they are cut and the gateway exits."""
 def main(argv: list[str] | None = None) -> int:
     """Serve HTTP until SIGINT/SIGTERM; exit 1 on a fatal start-up error."""
     parser = common_parser("linecrew gateway", "operator REST API of the ground station")
-    parser.add_argument("--host", default="127.0.0.1", help="HTTP bind address")
-    parser.add_argument("--port", type=int, default=8080, help="HTTP port")
+    parser.add_argument("--host", help="HTTP bind address (127.0.0.1)")
+    parser.add_argument("--port", type=int, help="HTTP port (8080; 0: any free port)")
     parser.add_argument("--token", help="bearer token (else --token-file, LINECREW_TOKEN)")
     parser.add_argument("--token-file", help="file holding the token (created if missing)")
-    parser.add_argument("--scenario", default="paper", help="site for gesture targets")
+    parser.add_argument("--scenario", help="shipped scenario name or scenario file (paper)")
     parser.add_argument("--gestures", help="a YAML gesture vocabulary")
-    parser.add_argument("--rpc-timeout", type=float, default=2.0, help="seconds before 503")
+    parser.add_argument("--rpc-timeout", type=float, help="seconds before 503 (2)")
     parser.add_argument("--tls-cert", help="serve HTTPS with this certificate (PEM)")
     parser.add_argument("--tls-key", help="the key of --tls-cert (PEM)")
     args = parser.parse_args(argv)
@@ -49,25 +46,25 @@ def main(argv: list[str] | None = None) -> int:
         parser.error("--tls-cert and --tls-key go together")
     bus_config = start(args, "gateway")
     try:
+        settings = GatewaySettings.from_env(
+            host=args.host,
+            port=args.port,
+            scenario=args.scenario,
+            rpc_timeout_s=args.rpc_timeout,
+            gestures=args.gestures,
+        )
         token = check_token(resolve_token(args.token, args.token_file))
-        scenario = load(args.scenario, site=args.site)
-        vocabulary = Vocabulary.load(args.gestures)
+        scenario = load(settings.scenario, site=args.site)
+        vocabulary = Vocabulary.load(settings.gestures)
         bus = Bus.open(bus_config)
-    except (DevTokenRefused, ScenarioError, Unavailable, OSError) as exc:
+    except (ValueError, ScenarioError, Unavailable, OSError) as exc:
         log.error("gateway cannot start: %s", exc)
         return 1
-    settings = GatewaySettings(
-        host=args.host,
-        port=args.port,
-        site=scenario.site.id,
-        token=token,
-        rpc_timeout_s=args.rpc_timeout,
-        gestures=args.gestures,
-    )
+    settings = dataclasses.replace(settings, token=token, site=scenario.site.id)
     with bus:
         bus.declare_token(KeySpace(settings.site).alive(Role.GATEWAY, "gateway"))
         client = GsClient(bus, settings.site, settings.rpc_timeout_s)
-        workers = WorkerPoses(scenario.site)
+        workers = WorkerPoses(scenario.site, mission_clock(args.speedup))
         bus.subscribe(client.keys.all_human_poses(), HumanPose, workers.on_pose)
         app = create_app(settings, client, scenario.site, vocabulary, workers)
         server = uvicorn.Server(

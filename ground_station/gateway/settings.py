@@ -7,19 +7,23 @@ import os
 import pathlib
 import secrets
 
+from linecrew.settings import NOT_FROM_ENV, EnvSettings
+
 
 @dataclasses.dataclass(frozen=True, kw_only=True)
-class GatewaySettings:
-    """Gateway settings (flags override ``LINECREW_GATEWAY_*`` / ``LINECREW_TOKEN``)."""
+class GatewaySettings(EnvSettings):
+    """Gateway settings (flags override ``LINECREW_GATEWAY_*`` variables)."""
+
+    ENV_PREFIX = "LINECREW_GATEWAY_"
 
     host: str = "127.0.0.1"  # HTTP bind address
     port: int = 8080  # HTTP port (0: any free port)
-    token: str = ""  # bearer token operators must send
-    site: str = "default"  # key space of the ground station
-    scenario: str = "paper"  # site used to resolve gesture targets
+    scenario: str = "paper"  # its site names gesture targets; its id is the key space
     rpc_timeout_s: float = 2.0  # ground station silent this long -> 503
     max_body_bytes: int = 64 * 1024  # larger request bodies -> 413
     gestures: str | None = None  # a YAML gesture vocabulary (default: the shipped one)
+    token: str = dataclasses.field(default="", metadata=NOT_FROM_ENV)  # see resolve_token
+    site: str = dataclasses.field(default="default", metadata=NOT_FROM_ENV)  # the scenario's
 
 
 DEV_TOKEN = "linecrew-dev-token"

@@ -10,18 +10,22 @@ from __future__ import annotations
 
 import dataclasses
 import json
-import os
 from typing import Literal
 
 import zenoh
+
+from linecrew.settings import EnvSettings
 
 Mode = Literal["client", "peer", "router"]
 DEFAULT_ROUTER = "tcp/127.0.0.1:7447"
 
 
 @dataclasses.dataclass(frozen=True, kw_only=True)
-class BusConfig:
-    """How a process joins the Zenoh network."""
+class BusConfig(EnvSettings):
+    """How a process joins the Zenoh network (flags override ``LINECREW_ZENOH_*``;
+    endpoint lists comma separated, e.g. ``LINECREW_ZENOH_CONNECT=tcp/a:7447,tcp/b:7447``)."""
+
+    ENV_PREFIX = "LINECREW_ZENOH_"
 
     mode: Mode = "client"
     connect: tuple[str, ...] = (DEFAULT_ROUTER,)  # endpoints to connect to
@@ -33,26 +37,9 @@ class BusConfig:
     connect_attempt_ms: int = 1000  # one attempt to reach a router when opening
     open_timeout_ms: int = 1000  # a transport handshake in flight; zenoh's 10 s default
     # stalls a reconnect started during a short network cut for 10 s
-    config_file: str | None = None  # a zenoh json5 file applied before the settings above
-
-    @classmethod
-    def from_env(cls, **overrides: object) -> BusConfig:
-        """Defaults, then ``LINECREW_ZENOH_CONNECT`` / ``_LISTEN`` (comma
-        separated), ``LINECREW_ZENOH_MODE``, ``LINECREW_ZENOH_LEASE_MS``,
-        ``LINECREW_ZENOH_CONFIG``, then ``overrides`` (``None`` values ignored)."""
-        env: dict[str, object] = {}
-        if value := os.environ.get("LINECREW_ZENOH_CONNECT"):
-            env["connect"] = _split(value)
-        if value := os.environ.get("LINECREW_ZENOH_LISTEN"):
-            env["listen"] = _split(value)
-        if value := os.environ.get("LINECREW_ZENOH_MODE"):
-            env["mode"] = value
-        if value := os.environ.get("LINECREW_ZENOH_LEASE_MS"):
-            env["lease_ms"] = int(value)
-        if value := os.environ.get("LINECREW_ZENOH_CONFIG"):
-            env["config_file"] = value
-        env.update({k: v for k, v in overrides.items() if v is not None})
-        return cls(**env)  # type: ignore[arg-type]
+    config_file: str | None = dataclasses.field(  # a zenoh json5 file applied before the above
+        default=None, metadata={"env": "LINECREW_ZENOH_CONFIG"}
+    )
 
     def to_zenoh(self) -> zenoh.Config:
         """The equivalent ``zenoh.Config``."""
@@ -76,7 +63,3 @@ class BusConfig:
         for key, value in settings.items():
             config.insert_json5(key, json.dumps(value))
         return config
-
-
-def _split(value: str) -> tuple[str, ...]:
-    return tuple(part.strip() for part in value.split(",") if part.strip())

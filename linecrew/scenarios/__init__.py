@@ -32,9 +32,9 @@ def builtin_names() -> list[str]:
 def load(name_or_path: str, *, site: str | None = None) -> Scenario:
     """A shipped scenario by name, or a YAML / JSON file by path.
 
-    The site id comes from the scenario; a ``site`` (a process's ``--site``)
-    that disagrees with it is an error naming both, so that no process of a
-    run listens on another site's keys."""
+    The site id comes from the scenario; a ``site`` (a process's ``--site``
+    or ``LINECREW_SITE``) that disagrees with it is an error naming both, so
+    that no process of a run listens on another site's keys."""
     path = _HERE / f"{name_or_path}.yaml"
     if not path.exists():
         path = pathlib.Path(name_or_path)
@@ -45,8 +45,8 @@ def load(name_or_path: str, *, site: str | None = None) -> Scenario:
     scenario = parse(path.read_bytes(), json=path.suffix == ".json", source=str(path))
     if site is not None and site != scenario.site.id:
         raise ScenarioError(
-            f"--site {site!r} disagrees with the scenario's site id {scenario.site.id!r} "
-            f"({path}); drop --site or use the scenario's"
+            f"site {site!r} (--site / LINECREW_SITE) disagrees with the scenario's site id "
+            f"{scenario.site.id!r} ({path}); drop it or use the scenario's"
         )
     return scenario
 
