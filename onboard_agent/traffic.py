@@ -77,7 +77,10 @@ class Traffic:
           moved over its slot as the UAV it relieved climbed out of it;
         - one heard nearer ``point`` (ties: the lower id) on its way to it
           (:func:`_coming`) holds it: of two UAVs sent to one point, the
-          nearer goes first (chaos seed 18)."""
+          nearer goes first (chaos seed 18);
+        - one heard coming straight down through it (:func:`_descending`,
+          a landing UAV cannot stop) holds it, however far above (chaos
+          seed 15: a UAV flew in under one landing and came up against it)."""
         others = self._others(now_s)
         targets = {s.uav_id: s.where for s in others if s.target and not s.unheard}
         level = here is None or abs(here.z_m - point.z_m) <= HOVER_M
@@ -105,7 +108,18 @@ class Traffic:
             if s.target and s.uav_id in heard and _coming(heard[s.uav_id], s.where, point, radius_m)
         ]
         first = [c for c in coming if c[:2] < mine]
-        return min(first, key=lambda c: c[:2])[2] if first else None
+        if first:
+            return min(first, key=lambda c: c[:2])[2]
+        return next(
+            (
+                s
+                for s in others
+                if s.target
+                and s.uav_id in heard
+                and _descending(heard[s.uav_id], s.where, point, radius_m)
+            ),
+            None,
+        )
 
     def obstacles(self, now_s: float) -> list[Point]:
         """Where other airborne UAVs hover or are about to: heard at their
@@ -159,6 +173,19 @@ def _coming(where: Point, target: Point, point: Point, radius_m: float) -> bool:
         and where.z_m >= target.z_m - HOVER_M
         and horizontal_distance(target, point) < radius_m
         and target.z_m > point.z_m - radius_m
+    )
+
+
+def _descending(where: Point, target: Point, point: Point, radius_m: float) -> bool:
+    """Whether a UAV heard at ``where`` comes straight down through
+    ``point`` to a target below it: its target right below it (within
+    ``HOVER_M`` horizontally), ``point`` within ``radius_m`` of its column
+    horizontally and between the two heights (more than ``HOVER_M`` above
+    the target: one coming down *to* the point goes first only if nearer)."""
+    return (
+        horizontal_distance(where, target) < HOVER_M
+        and horizontal_distance(where, point) < radius_m
+        and target.z_m + HOVER_M < point.z_m < where.z_m
     )
 
 

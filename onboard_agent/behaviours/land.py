@@ -4,6 +4,7 @@ from __future__ import annotations
 
 from onboard_agent.behaviours.base import AgentBehaviour, CommandSlot, Status
 from onboard_agent.context import Context
+from proto.geo import Point
 from proto.telemetry import FlightState
 
 
@@ -44,6 +45,8 @@ class Land(AgentBehaviour):
                 return Status.RUNNING
             self.command.issue("land", self.ctx.autopilot.land())
             self._sent = True
+            here = vehicle.position  # telemetry says where it comes down: others keep out
+            self.ctx.heading_to = Point(x_m=here.x_m, y_m=here.y_m, z_m=0.0)
         self.feedback_message = f"landing, {vehicle.position.z_m:.1f} m"
         return Status.RUNNING
 

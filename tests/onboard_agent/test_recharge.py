@@ -44,3 +44,16 @@ def test_go_home_flies_to_the_station_and_lands():
     state = rig.autopilot.state
     assert state.landed and on_a_spot(state.position, "C2")
     assert [o.result for o in rig.outcomes()] == [OutcomeResult.COMPLETED]
+
+
+def test_a_landing_uav_reports_the_ground_below_it_as_its_target():
+    """Others keep out of the column a landing UAV comes down through (chaos
+    seed 15): its telemetry's target is the ground right below it."""
+    rig = Rig(position=point(0, 7, 3))
+    rig.autopilot.update(flight_state=FlightState.FLYING, armed=True, mode="GUIDED")
+    rig.autopilot.hold.add("land")  # LAND sent, the vehicle still coming down
+    rig.agent.offer_plan(plan(GoHomeTask(task_id="h1", station_id="C2", position=H)))
+    rig.run_until(lambda: "land" in rig.autopilot.names())
+    here, target = rig.autopilot.state.position, rig.agent.telemetry().target
+    assert target is not None and here.z_m > 0
+    assert (target.x_m, target.y_m, target.z_m) == (here.x_m, here.y_m, 0.0)

@@ -78,6 +78,22 @@ def test_a_uav_leaving_the_point_no_longer_holds_it_for_one_level_with_it():
     assert staying.holder(SLOT, 2.0, 0.0, here=p(3.0, 0.0, 6.0)) is not None
 
 
+def test_a_uav_landing_holds_every_point_of_its_column_below_it():
+    """Chaos seed 15: uav-1 landed straight down from 17 m at a station
+    while uav-2 flew in under it to a point 6 m above the same spot. The
+    landing UAV (its target the ground below it) holds that point however
+    far above it is and whoever is nearer; a point beside its column, or
+    above it, is free."""
+    landing = report(entry(p(0.0, 0.0, 15.0), target=p(0.0, 0.0, 0.0)))
+    here = p(-3.0, 0.0, 11.7)
+    seen = landing.holder(SLOT, 2.0, 0.0, here)
+    assert seen is not None and seen.uav_id == "uav-2"
+    assert landing.holder(p(3.0, 0.0, 6.0), 2.0, 0.0, here) is None
+    assert landing.holder(p(0.0, 0.0, 20.0), 2.0, 0.0, p(-3.0, 0.0, 22.0)) is None
+    flying_level = report(entry(p(0.0, 0.0, 15.0), target=p(9.0, 0.0, 15.0)))
+    assert flying_level.holder(SLOT, 2.0, 0.0, here) is None
+
+
 def test_a_climb_target_is_an_obstacle_for_uavs_after_the_climber_only():
     """Chaos seed 12: uav-1 and uav-2 climbed side by side out of C2, each
     crossing over the other's climb target, up to 150 m. The one later in
