@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import math
-import time
 
 import msgspec
 import pytest
@@ -82,10 +81,10 @@ def test_a_pose_stamped_from_the_future_is_refused_and_later_real_poses_still_co
     rig = Rig()
     surroundings = rig.agent.ctx.surroundings
     forged = HumanPose(
-        worker_id="W2", stamp_s=time.time() + 3600, position=point(9, 9, 3), geo=GeoPoint()
+        worker_id="W2", stamp_s=rig.wall() + 3600, position=point(9, 9, 3), geo=GeoPoint()
     )
     rig.agent.human_pose(forged)
-    real = HumanPose(worker_id="W2", stamp_s=time.time(), position=point(1, 1, 3), geo=GeoPoint())
+    real = HumanPose(worker_id="W2", stamp_s=rig.wall(), position=point(1, 1, 3), geo=GeoPoint())
     rig.agent.human_pose(real)
     assert surroundings.worker_position("W2") == point(1, 1, 3) and surroundings.refused == 1
 
