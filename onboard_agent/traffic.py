@@ -130,7 +130,10 @@ class Traffic:
 
         The point a heard UAV climbs to counts only for UAVs after it in id
         order: two UAVs climbing side by side, each over the other's climb
-        target, went on raising their crossings to 695 m (chaos seed 12)."""
+        target, went on raising their crossings to 695 m (chaos seed 12).
+        So does where a heard UAV on its way is now: of two UAVs whose
+        tracks cross, the later in id order crosses over the other, which
+        flies on (chaos seed 20: two swapping slots met head on at 6 m)."""
         others = self._others(now_s)
         heard = {s.uav_id: s.where for s in others if not s.target}
 
@@ -138,11 +141,13 @@ class Traffic:
             where = heard.get(s.uav_id)
             return where is not None and s.where.z_m > where.z_m + HOVER_M
 
-        return [
-            s.where
-            for s in others
-            if s.unheard or s.hovering or (s.target and (not climbing(s) or s.uav_id < self.uav_id))
-        ]
+        def counts(s: Sighting) -> bool:
+            if s.unheard or s.hovering:
+                return True
+            earlier = s.uav_id < self.uav_id
+            return earlier if not s.target or climbing(s) else True
+
+        return [s.where for s in others if counts(s)]
 
     def _others(self, now_s: float) -> list[Sighting]:
         """Where the other airborne UAVs of the report may be: where each

@@ -6,6 +6,7 @@ from __future__ import annotations
 import msgspec
 import pytest
 
+from onboard_agent.route import next_leg
 from onboard_agent.traffic import Traffic
 from proto.geo import Point
 from proto.telemetry import Traffic as TrafficReport
@@ -110,3 +111,25 @@ def test_a_climb_target_is_an_obstacle_for_uavs_after_the_climber_only():
     level = msgspec.structs.replace(climb, target=p(9, 20, 5))  # on its way, level: counts
     earlier.update(TrafficReport(uavs=[level]), 0.0)
     assert p(9, 20, 5) in earlier.obstacles(0.0)
+
+
+def test_of_two_uavs_whose_tracks_cross_the_later_in_id_order_crosses_over():
+    """Chaos seed 20: uav-1 and uav-2 swapped slots on straight tracks at
+    6-9 m and met head on. Where uav-1 is on its way is an obstacle for
+    uav-2, which crosses over it at a level of its own; uav-1 flies on."""
+    uav1_at, uav1_to = p(2.5, 10.5, 7.3), p(-12.0, 15.0, 6.0)
+    uav2_at, uav2_to = p(-8.9, 15.0, 8.9), p(7.0, 10.0, 6.0)
+    uavs = [
+        TrafficEntry(uav_id="uav-1", position=uav1_at, airborne=True, target=uav1_to),
+        TrafficEntry(uav_id="uav-2", position=uav2_at, airborne=True, target=uav2_to),
+    ]
+    seen = {}
+    for me in ("uav-1", "uav-2"):
+        seen[me] = Traffic(me)
+        seen[me].update(TrafficReport(uavs=uavs), 0.0)
+    assert uav1_at in seen["uav-2"].obstacles(0.0) and uav2_at not in seen["uav-1"].obstacles(0.0)
+    clear = 2.5
+    assert next_leg(uav1_at, uav1_to, seen["uav-1"].obstacles(0.0), clear, layer=(0, 3)) == uav1_to
+    leg = next_leg(uav2_at, uav2_to, seen["uav-2"].obstacles(0.0), clear, layer=(1, 3))
+    assert (leg.x_m, leg.y_m) == (uav2_at.x_m, uav2_at.y_m)  # up first, where it is
+    assert leg.z_m >= uav1_at.z_m + clear
