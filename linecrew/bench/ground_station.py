@@ -33,7 +33,7 @@ from collections.abc import Callable
 
 import msgspec
 
-from ground_station.light_agent import LightAgent
+from linecrew.bench.light_agent import LightAgent
 from linecrew.bus import Bus, BusConfig
 from linecrew.bus.router_process import router_process
 from linecrew.latency import percentile_ms

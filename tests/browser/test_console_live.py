@@ -158,10 +158,12 @@ def test_actions_from_the_forms_are_planned_flown_and_completed(run, new_page, g
 
     # the markers move, with a planned route ahead
     first = markers(page)
-    time.sleep(1.5)
-    second = markers(page)
-    moved = {u for u in UAVS if math.dist(first[u], second[u]) > 0.3}
-    assert moved, (first, second)
+
+    def moved() -> set[str]:
+        now = markers(page)
+        return {u for u in UAVS if math.dist(first[u], now[u]) > 0.3}
+
+    wait_until(moved, 30, "a UAV marker moves", period_s=0.2)
     assert page.locator("#map .route[points*=' ']").count() >= 1
     assert page.locator(f"#map .wp[data-action='{inspect}']").count() == 3
     shoot(page, artefacts, "flying", keep=True)

@@ -10,7 +10,7 @@ from collections.abc import Iterable
 
 import pytest
 
-from ground_station.light_agent import LightAgent
+from linecrew.bench.light_agent import LightAgent
 from linecrew.bus import Bus
 from linecrew.scenarios import load
 from proto import (

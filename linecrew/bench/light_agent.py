@@ -1,5 +1,5 @@
-"""A light stand-in for an onboard agent, for benchmarks and tests of the
-ground station: a real Zenoh client that declares the agent's token,
+"""A light stand-in for an onboard agent, for the ground-station bench and
+tests: a real Zenoh client that declares the agent's token,
 publishes telemetry at 5 Hz from a fixed position, and records the plans it
 receives with their arrival times. It flies nothing."""
 
