@@ -52,8 +52,10 @@ class GroundStation:
         bus: Bus,
         clock: Callable[[], float] = time.time,
         speedup: float = 1.0,
+        link_clock: Callable[[], float] = time.monotonic,
     ) -> None:
         self.config = config
+        self.link_clock = link_clock  # real seconds: silences, losses, traffic ages
         self.traffic_period_s = config.traffic_period(speedup)
         self.bus = bus
         self.clock = clock
@@ -153,12 +155,12 @@ class GroundStation:
 
     def _on_telemetry(self, key: str, telemetry: Telemetry) -> None:
         if self._bound(key, telemetry.uav_id, telemetry.stamp_s):
-            self.monitor.on_telemetry(telemetry, time.monotonic())
+            self.monitor.on_telemetry(telemetry, self.link_clock())
             self.manager.reports.on_telemetry(telemetry)
 
     def _on_status(self, key: str, status: AgentStatus) -> None:
         if self._bound(key, status.uav_id, status.stamp_s):
-            self.monitor.on_status(status, time.monotonic())
+            self.monitor.on_status(status, self.link_clock())
             self.manager.reports.on_status(status)
 
     def _on_outcome(self, key: str, outcome: TaskOutcome) -> None:
@@ -168,13 +170,13 @@ class GroundStation:
     def _on_token(self, key: str, alive: bool) -> None:
         parsed = self.keys.parse(key)
         if parsed.ident is not None:
-            self.monitor.on_token(parsed.ident, alive, time.monotonic())
+            self.monitor.on_token(parsed.ident, alive, self.link_clock())
 
     async def _watchdog(self) -> None:
         while True:
             try:
                 self.manager.retry_unsaved()
-                self.manager.on_fleet_changes(self.monitor.check(time.monotonic()))
+                self.manager.on_fleet_changes(self.monitor.check(self.link_clock()))
                 self.manager.retry_unplaced()
             except Exception:
                 log.exception("watchdog step failed")
@@ -184,7 +186,7 @@ class GroundStation:
         """Tell the agents where every UAV is, ``traffic_period_s`` apart."""
         while True:
             try:
-                report = self.monitor.traffic(time.monotonic())
+                report = self.monitor.traffic(self.link_clock())
                 epoch = self.store.counter("epoch")
                 announced = msgspec.structs.replace(report, generation=self.generation, epoch=epoch)
                 self.bus.publish(self.keys.traffic(), announced)
