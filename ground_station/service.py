@@ -207,14 +207,15 @@ class GroundStation:
     def _plan_query(self, key: str, request: GetPlans) -> PlansReply:
         """A UAV's plan, to the UAV whose key the query was sent to only."""
         parsed = self.keys.parse(key)  # a wildcard query is no UAV's: refused
-        if parsed.kind != "uav" or request.uav_id not in (None, parsed.ident):
+        if parsed.kind != "uav" or not parsed.ident or request.uav_id not in (None, parsed.ident):
             raise RequestError(
                 f"a query on {key} reads only the plan of {parsed.ident}",
                 code="forbidden",
                 field="uav_id",
             )
-        plan = self.replanner.plans.get(parsed.ident or "")
-        return PlansReply(plans=[plan] if plan else [], **self.manager.plan_quality())
+        reply = self.manager.handle(GetPlans(uav_id=parsed.ident))  # as an operator sees it
+        assert isinstance(reply, PlansReply)
+        return reply
 
     def metrics(self) -> dict[str, float]:
         """Counters and timings in one place."""
