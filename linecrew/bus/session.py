@@ -324,8 +324,12 @@ def _undeclare(handle: Any) -> None:
 
 
 def _error_from(key: str, payload: bytes) -> RequestError:
+    """The error an error reply on ``key`` stands for: the server's own
+    (:class:`ErrorReply`), else one from the network on its behalf (Zenoh
+    answers ``Timeout`` for a query it gave up on, e.g. across a cut):
+    a :class:`RequestTimeout`, safe to retry, not a server failure."""
     try:
         error = codec.decode(payload, ErrorReply)
     except DecodeError:
-        return RequestError(f"error reply from {key}: {payload[:200]!r}")
+        return RequestTimeout(f"the network answered for {key}: {payload[:200]!r}")
     return RequestError(error.message, code=error.code, field=error.field)

@@ -237,3 +237,21 @@ def test_zenoh_config_disables_multicast_and_sets_the_lease():
     assert config.get_json("scouting/multicast/enabled") == "false"
     assert config.get_json("transport/link/tx/lease") == "500"
     assert isinstance(config, zenoh.Config)
+
+
+def test_an_error_reply_from_the_network_is_a_timeout_not_a_server_failure(two_buses):
+    """Zenoh answers ``Timeout`` for a query it gave up on (across a cut,
+    chaos seed 13): a retryable RequestTimeout (503 at the gateway), not a
+    RequestError with no code (500, and the cancel it carried counted lost)."""
+    server, client = two_buses
+    queryable = server.session.declare_queryable(KEYS.rpc("cut"), lambda q: q.reply_err(b"Timeout"))
+    try:
+        for _ in range(100):
+            with pytest.raises(RequestTimeout) as caught:
+                client.query(KEYS.rpc("cut"), GetHistory(), HistoryReply, 2.0)
+            if "network" in str(caught.value):
+                break  # routed (before that: nobody answered)
+        assert "the network answered" in str(caught.value) and "Timeout" in str(caught.value)
+        assert caught.value.code == "request_timeout"
+    finally:
+        queryable.undeclare()
