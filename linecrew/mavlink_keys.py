@@ -13,12 +13,16 @@ import hashlib
 import pathlib
 import time
 
+from proto.errors import LinecrewError
+
 SIGNING_EPOCH_S = 1420070400  # MAVLink signing timestamps count from 2015-01-01 UTC
 MIN_PASSPHRASE = 8
 
 
-class SigningKeyError(ValueError):
+class SigningKeyError(LinecrewError, ValueError):
     """A key file that is missing, empty or too short (the path is in the message)."""
+
+    code = "signing_key_invalid"
 
 
 def load_key(path: str | pathlib.Path) -> bytes:

@@ -11,6 +11,19 @@
     └── RequestError        "request_error"    an RPC answered with a typed error reply
         └── RequestTimeout  "request_timeout"  nobody answered in time
 
+Grown from ``LinecrewError`` where they are raised (each also the builtin
+it was before, so existing handlers still catch it):
+
+    PlanningProblemError  "planning_problem_invalid"    ground_station.planner (ValueError)
+    DevTokenRefused       "dev_token_refused"           ground_station.gateway (ValueError)
+    SigningKeyError       "signing_key_invalid"         linecrew.mavlink_keys (ValueError)
+    StartError            "start_failed"                linecrew.launch.supervisor
+    SecureProfileError    "secure_profile_unavailable"  linecrew.launch.secure
+    NetnsError            "netns_unavailable"           linecrew.chaos.netns (RuntimeError)
+    RunDirError           "run_dir_invalid"             linecrew.report.data (RuntimeError)
+    NoRunError            "no_run"                      linecrew.client.session (RuntimeError)
+    NotReady              "fleet_not_ready"             linecrew.bench.fleet (RuntimeError)
+
 Each class carries a stable ``code`` (the string that also travels in
 :class:`proto.rpc.ErrorReply`) and a human message.
 """

@@ -8,6 +8,7 @@ import pathlib
 import secrets
 
 from linecrew.settings import NOT_FROM_ENV, EnvSettings
+from proto.errors import LinecrewError
 
 
 @dataclasses.dataclass(frozen=True, kw_only=True)
@@ -31,8 +32,10 @@ DEV_TOKEN = "linecrew-dev-token"
 ``LINECREW_ALLOW_DEV_TOKEN=1`` says this is a development run."""
 
 
-class DevTokenRefused(ValueError):
+class DevTokenRefused(LinecrewError, ValueError):
     """The gateway was given the public development token without the flag."""
+
+    code = "dev_token_refused"
 
 
 def check_token(token: str) -> str:

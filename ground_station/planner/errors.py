@@ -4,14 +4,17 @@
 
     PlanningProblemError   invalid input; ``field`` names the offending path
 
-Expected planning failures are not exceptions: they are ``Unplaced`` values
+It is a ``LinecrewError`` (:mod:`proto.errors`), as is every error linecrew
+raises on purpose. Expected planning failures are not exceptions: they are ``Unplaced`` values
 in the returned plan. Any other exception is a bug.
 """
 
 from __future__ import annotations
 
+from proto.errors import LinecrewError
 
-class PlanningProblemError(ValueError):
+
+class PlanningProblemError(LinecrewError, ValueError):
     """The problem (or plan) document is invalid.
 
     Raised by the loaders and by ``plan``/``replan`` before any work. Not

@@ -42,13 +42,16 @@ from linecrew.launch.supervisor import StartError
 from linecrew.logs import configure_logging
 from linecrew.scenarios import load, with_fleet_size
 from proto import AgentStatus, EventKind, GetHistory, GsEvent, HistoryReply, Plan, UavTopic
+from proto.errors import LinecrewError
 
 READY_TIMEOUT_S = 120.0
 PLAN_TIMEOUT_S = 10.0
 
 
-class NotReady(RuntimeError):
+class NotReady(LinecrewError, RuntimeError):
     """Agents that never reported ready."""
+
+    code = "fleet_not_ready"
 
 
 class FleetWatch:

@@ -27,11 +27,15 @@ import shutil
 import subprocess
 from collections.abc import Iterator
 
+from proto.errors import LinecrewError
+
 NFT_TABLE = "lcchaos"
 
 
-class NetnsError(RuntimeError):
+class NetnsError(LinecrewError, RuntimeError):
     """Network namespaces cannot be used here; the message says why."""
+
+    code = "netns_unavailable"
 
 
 def _ip(*args: str) -> None:

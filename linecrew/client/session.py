@@ -30,13 +30,16 @@ from collections.abc import Iterator
 import httpx
 
 from linecrew.client.gateway import Gateway, tls_verify
+from proto.errors import LinecrewError
 
 SESSION_ENV = "LINECREW_SESSION"
 SESSION_NAME = pathlib.Path(".linecrew") / "session.json"
 
 
-class NoRunError(RuntimeError):
+class NoRunError(LinecrewError, RuntimeError):
     """No gateway to talk to; the message (one line) says what was tried."""
+
+    code = "no_run"
 
 
 @dataclasses.dataclass(frozen=True)

@@ -19,13 +19,16 @@ import subprocess
 import sys
 
 from linecrew.mavlink_keys import key_path
+from proto.errors import LinecrewError
 
 GEN = pathlib.Path(__file__).resolve().parents[2] / "deploy" / "tls" / "gen-dev-ca.sh"
 UAV_ID = re.compile(r"uav-(\d+)")
 
 
-class SecureProfileError(RuntimeError):
+class SecureProfileError(LinecrewError):
     """The profile cannot be set up here (what is missing is in the message)."""
+
+    code = "secure_profile_unavailable"
 
 
 @dataclasses.dataclass(frozen=True)

@@ -17,6 +17,8 @@ import sys
 import time
 from collections.abc import Callable, Mapping
 
+from proto.errors import LinecrewError
+
 log = logging.getLogger(__name__)
 
 _PR_SET_PDEATHSIG = 1
@@ -27,8 +29,10 @@ def _die_with_parent() -> None:  # runs in the child between fork and exec
         ctypes.CDLL("libc.so.6", use_errno=True).prctl(_PR_SET_PDEATHSIG, signal.SIGTERM)
 
 
-class StartError(RuntimeError):
+class StartError(LinecrewError):
     """A child exited or never became healthy; the message names it and its log."""
+
+    code = "start_failed"
 
 
 @dataclasses.dataclass

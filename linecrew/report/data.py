@@ -19,6 +19,7 @@ from typing import Any
 import msgspec
 
 from proto import codec
+from proto.errors import LinecrewError
 from proto.events import GsEvent
 from proto.mission import ActionRecord
 from proto.plan import Plan
@@ -32,8 +33,10 @@ def tag(value: msgspec.Struct) -> str:
     return str(type(value).__struct_config__.tag)
 
 
-class RunDirError(RuntimeError):
+class RunDirError(LinecrewError, RuntimeError):
     """Not a run directory, or one whose store cannot be read; the message says what is missing."""
+
+    code = "run_dir_invalid"
 
 
 @dataclasses.dataclass(frozen=True)
