@@ -25,7 +25,15 @@ from ground_station.replanner import Replanner
 from ground_station.store import StoreUnavailable
 from proto.events import EventKind
 from proto.mission import ActionRecord, ActionState
-from proto.plan import DeliverTask, InspectTask, MonitorTask, PickTask, RechargeTask, Task
+from proto.plan import (
+    DeliverTask,
+    InspectTask,
+    MonitorTask,
+    PickTask,
+    RechargeTask,
+    Task,
+    WaitTask,
+)
 from proto.rpc import UavOpState
 from proto.scenario import Scenario
 from proto.telemetry import (
@@ -43,7 +51,9 @@ ACTION_TASKS = (InspectTask, MonitorTask, PickTask, DeliverTask)
 """Tasks whose completion is a replanning trigger (the paper's "task
 finished"). A finished wait, recharge or flight home changes nothing the
 plan did not already expect, so it replans nothing, unless an action is
-waiting for a UAV (then a UAV back on its pad or recharged may take it)."""
+waiting for a UAV and the UAV is back on its pad or recharged (it may take
+it); a finished wait never does (the UAV is as it was: chaos seed 15 replanned
+on every wait it finished, and got the same wait again)."""
 
 IDLE_MISMATCH_S = 5.0
 """Mission seconds an agent may report idle while its plan has tasks."""
@@ -171,7 +181,7 @@ class AgentReports:
         trigger = (
             outcome.result != OutcomeResult.COMPLETED
             or isinstance(task, ACTION_TASKS)
-            or self._waiting_for_a_uav()
+            or (not isinstance(task, WaitTask) and self._waiting_for_a_uav())
         )
         if trigger and not self._round_ending(outcome.uav_id, task):
             self.replan(f"{outcome.uav_id} {outcome.task_id} {outcome.result}")

@@ -84,6 +84,20 @@ def test_a_finished_wait_replans_nothing_and_the_synchronised_start_stays(gs):
     assert again == starts, "the promised start did not move"
 
 
+def test_a_finished_wait_replans_nothing_while_an_action_waits_for_a_uav(gs, monkeypatch):
+    """Chaos seed 15: with an action waiting for a UAV, every finished wait
+    replanned, and the replan gave the UAV a wait until now again: 62,000
+    plans, and the UAV never left its pad. A wait it finishes changes
+    nothing (a recharge does: the UAV may now take the action)."""
+    plans = pair_monitor(gs)
+    monkeypatch.setattr(gs.manager.reports, "_waiting_for_a_uav", lambda: True)
+    waiting = next((u for u, tasks in plans.items() if tasks and isinstance(tasks[0], WaitTask)))
+    replans = gs.replanner.stats.count
+    gs.now = plans[waiting][0].until_s
+    outcome(gs, waiting, plans[waiting][0])
+    assert gs.replanner.stats.count == replans, "a finished wait is not a trigger"
+
+
 def test_a_replan_that_changes_nothing_bumps_no_epoch_and_emits_no_event(gs):
     pair_monitor(gs)
     epoch, events = gs.store.counter("epoch"), len(gs.events)
