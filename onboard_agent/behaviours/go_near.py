@@ -162,8 +162,9 @@ class GoNear(AgentBehaviour):
             self.feedback_message = "setting GUIDED"
             return Status.RUNNING
         now = ctx.clock()
-        if self._yielding(point, now):
-            return Status.RUNNING
+        held = self._yielding(point, now)
+        if held is not None:
+            return held
         clear_m = ctx.surroundings.site.safety.people_clearance_m + config.route_margin_m
         traffic = ctx.traffic.obstacles(ctx.link_clock())
         obstacles = (
@@ -183,15 +184,19 @@ class GoNear(AgentBehaviour):
         self.feedback_message = f"flying to {self.target.label}, {distance:.1f} m"
         return Status.RUNNING
 
-    def _yielding(self, point: Point, now: float) -> bool:
-        """Hold where the UAV is while another airborne UAV is at ``point``
-        (from the traffic report): as long as it is heard there (flying on
-        would fly into it; chaos seed 16: a relief came down onto the UAV it
-        relieved, still watching from the slot), at most ``yield_max_s`` if
-        it is only thought to be there (unheard, at the target it flew to:
-        a hung agent; the ground station moves a lost UAV's slot) or this
-        UAV is in an emergency (its battery decides: two UAVs low on energy
-        holding for each other at a station must not both fall, seed 12)."""
+    def _yielding(self, point: Point, now: float) -> Status | None:
+        """RUNNING (holding where the UAV is) while another airborne UAV is
+        at ``point`` (from the traffic report): as long as it is heard there
+        (flying on would fly into it; chaos seed 16: a relief came down onto
+        the UAV it relieved, still watching from the slot). One only thought
+        to be there (unheard: a hung agent, whose autopilot hovers on at its
+        last target) is waited for ``yield_max_s``; then the behaviour fails,
+        retryable (``point_occupied``: the ground station replans, and moves
+        a lost UAV's slot), never flying into it (chaos seed 12: a UAV sent
+        to a waypoint where one with a killed agent hovered met it 0.95 m
+        apart). In an emergency the UAV flies on after ``yield_max_s`` (its
+        battery decides: two UAVs low on energy holding for each other at a
+        station must not both fall, seed 12). None: not holding."""
         ctx, config = self.ctx, self.ctx.config
         radius = max(config.keep_clear_m, ctx.surroundings.site.safety.separation_m)
         here = ctx.vehicle.position
@@ -200,7 +205,7 @@ class GoNear(AgentBehaviour):
             other = ctx.traffic.holder(point, radius, ctx.link_clock(), here)
         if other is None:
             self._yield_since = ctx.holding_for = None
-            return False
+            return None
         if self._yield_since is None:
             self._yield_since = now
             self._sent = None
@@ -210,17 +215,20 @@ class GoNear(AgentBehaviour):
                 self.target.label,
                 extra={"uav_id": ctx.uav_id},
             )
-        bounded = other.unheard or bool(ctx.emergency)
-        if bounded and now - self._yield_since > config.yield_max_s:
+        if (other.unheard or ctx.emergency) and now - self._yield_since > config.yield_max_s:
             ctx.holding_for = None
-            return False  # not heard for long, or no time left: fly on
+            if ctx.emergency:
+                return None  # no time left: fly on
+            self.feedback_message = f"{other.uav_id}, unheard, still at the {self.target.label}"
+            self.failure_code, self.retryable = "point_occupied", True
+            return Status.FAILURE
         ctx.holding_for = other.uav_id
         if self._sent is None or now - self._sent_at >= config.goto_resend_s:
             self._sent = self._sent or here
             ctx.goto(self._sent)
             self._sent_at = now
         self.feedback_message = f"holding off: {other.uav_id} is at the {self.target.label}"
-        return True
+        return Status.RUNNING
 
     def terminate(self, new_status: Status) -> None:
         self.ctx.holding_for = None

@@ -166,19 +166,27 @@ def test_the_slot_is_flown_to_only_once_the_uav_hovering_there_has_left():
     assert outcome.result is OutcomeResult.COMPLETED
 
 
-def test_a_uav_that_never_leaves_the_point_is_waited_for_at_most_yield_max_s():
+def test_a_uav_unheard_at_the_point_is_waited_for_yield_max_s_then_the_task_fails_retryable():
+    """Chaos seed 12: a UAV sent to a waypoint where one with a killed agent
+    hovered on flew into it once ``yield_max_s`` had passed. It waits that
+    long, then gives the task back (retryable, ``point_occupied``), never
+    having flown to the point."""
     rig = Rig()
     rig.agent.offer_plan(plan(monitor(slot=0, slots=1, duration_s=3.0)))
     slot = point(W2.x_m + 4.0, W2.y_m, W2.z_m + 3.0)
     rig.run_until(lambda: rig.leaf() == "Go near Human Target", arrive=False)
     rig.tick(5, arrive=False)
-    _traffic_at(rig, slot)
+    _traffic_at(rig, slot)  # heard there once, then never again: unheard after 1 s
     started = rig.clock()
     rig.tick(3, arrive=False)
     assert rig.agent.status().holding_for == "uav-2"
-    rig.run_until(lambda: rig.leaf() == "Monitoring")
+    seen: list = []
+    rig.run_until(lambda: seen.extend(rig.outcomes()) or seen, arrive=False)
+    [outcome] = seen
+    assert outcome.result is OutcomeResult.FAILED and outcome.retryable
+    assert outcome.reason_code == "point_occupied"
     assert rig.clock() - started >= rig.agent.ctx.config.yield_max_s
-    assert rig.agent.status().holding_for is None  # it flew on: no longer holding off
+    assert rig.autopilot.target is None or rig.autopilot.target.distance_to(slot) > 2.0
 
 
 def test_a_relief_waits_while_the_uav_it_relieves_is_heard_at_the_slot():
