@@ -1,2 +1,5 @@
-"""The ground station: the site's Zenoh router, and (to come) the mission
-manager, planner, fleet monitor, durable store and operator gateway."""
+"""The ground station: the mission manager (actions in, per-UAV plans out),
+the planner (``ground_station.planner``, a pure library), the fleet monitor,
+the durable SQLite store and the operator REST gateway
+(``ground_station.gateway``). The Zenoh router process is
+``linecrew.bus.router``."""

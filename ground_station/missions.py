@@ -32,7 +32,7 @@ from ground_station.plan_worker import PlanWorker
 from ground_station.replan_jobs import Computed, Job, ReplanOutcome
 from ground_station.replanner import Replanner
 from ground_station.store import Store, StoreUnavailable
-from ground_station.validation import validate
+from ground_station.validation import InvalidAction, validate
 from proto.errors import RequestError
 from proto.events import EventKind
 from proto.mission import ActionRecord, ActionState, DeliverAction, MonitorAction
@@ -223,9 +223,7 @@ class MissionManager:
         record = self.book.live_record(request.action_id)
         action = request.action or record.action
         if type(action) is not type(record.action):
-            raise RequestError(
-                "cannot change an action's kind", code="invalid_action", field="action.type"
-            )
+            raise InvalidAction("cannot change an action's kind", field="action.type")
         if request.priority is not None:
             action = msgspec.structs.replace(action, priority=request.priority)
         validate(action, self.scenario.site, self.scenario.fleet)
