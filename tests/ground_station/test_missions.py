@@ -21,6 +21,7 @@ from proto import (
     InspectTask,
     LandTask,
     ModifyAction,
+    MonitorAction,
     OutcomeResult,
     PickTask,
     RequestError,
@@ -99,6 +100,15 @@ def test_modify_changes_priority_and_refuses_finished_actions(gs):
     gs.settle()
     with pytest.raises(Exception, match="cancelled"):
         gs.manager.modify(ModifyAction(request_id="m2", action_id="inspect-loop", priority=1))
+
+
+def test_an_edit_that_changes_the_action_kind_is_an_invalid_action(gs):
+    gs.submit("inspect-loop")
+    watch = MonitorAction(worker_id="W1", uavs=1, standoff_m=3, duration_s=60)
+    edit = ModifyAction(request_id="m", action_id="inspect-loop", action=watch)
+    with pytest.raises(InvalidAction) as refused:
+        gs.manager.modify(edit)
+    assert (refused.value.code, refused.value.field) == ("invalid_action", "action.type")
 
 
 def _inspecting(gs, action_id: str) -> set[str]:
