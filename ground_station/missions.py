@@ -131,13 +131,18 @@ class MissionManager:
                 self.control(request)
                 return self.fleet()
             case GetPlans(uav_id=uav_id):
-                plans = self.replanner.plans
-                chosen = [plans[uav_id]] if uav_id in plans else [] if uav_id else plans.values()
-                return PlansReply(plans=list(chosen), **self.plan_quality())
+                return self.plans(uav_id)
             case GetHistory(after_seq=after, limit=limit):
                 events = fitting(self.events.after(after, limit))
                 return HistoryReply(events=events, last_seq=self.events.last_seq)
         raise RequestError(f"unsupported request {type(request).__name__}")
+
+    def plans(self, uav_id: str | None = None) -> PlansReply:
+        """The current plans (of ``uav_id`` only, if given), with the live
+        plan's quality: what operators and an agent's resync query read."""
+        plans = self.replanner.plans
+        chosen = [plans[uav_id]] if uav_id in plans else [] if uav_id else plans.values()
+        return PlansReply(plans=list(chosen), **self.plan_quality())
 
     def fleet(self) -> FleetReply:
         """Every UAV's state, with the operator's command in force."""

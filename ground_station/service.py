@@ -213,9 +213,7 @@ class GroundStation:
                 code="forbidden",
                 field="uav_id",
             )
-        reply = self.manager.handle(GetPlans(uav_id=parsed.ident))  # as an operator sees it
-        assert isinstance(reply, PlansReply)
-        return reply
+        return self.manager.plans(parsed.ident)  # as an operator sees it
 
     def metrics(self) -> dict[str, float]:
         """Counters and timings in one place."""

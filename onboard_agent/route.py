@@ -106,7 +106,7 @@ def next_leg(
     if layer is not None and crossing > max(here.z_m, target.z_m) + TOLERANCE_M:
         crossing = own_level(crossing, *layer)  # over something: at a level of its own
     elif layer is not None and here.z_m > needed + TOLERANCE_M:
-        crossing = nearest_level(here.z_m, needed, *layer)  # higher than it needs: the same
+        crossing = level_below(here.z_m, needed, *layer)  # higher than needed: its own, below
     if math.hypot(target.x_m - here.x_m, target.y_m - here.y_m) <= TOLERANCE_M:
         return _sidestep(here, target, traffic, target.z_m) or target  # straight up or down
     if here.z_m < crossing - TOLERANCE_M:
@@ -140,7 +140,7 @@ def _sidestep(here: Point, target: Point, obstacles: Iterable[Point], to_z: floa
     return Point(x_m=p.x_m + dx * scale, y_m=p.y_m + dy * scale, z_m=here.z_m)
 
 
-def nearest_level(z_m: float, at_least_m: float, place: int, fleet_size: int) -> float:
+def level_below(z_m: float, at_least_m: float, place: int, fleet_size: int) -> float:
     """The cruise level of the UAV at ``place`` at or below ``z_m`` (within
     ``TOLERANCE_M``: its own) and not below ``at_least_m``; ``z_m`` if there
     is none. Where a UAV higher than its flight needs (re-routed mid-climb,

@@ -142,10 +142,9 @@ class Traffic:
             return where is not None and s.where.z_m > where.z_m + HOVER_M
 
         def counts(s: Sighting) -> bool:
-            if s.unheard or s.hovering:
+            if s.unheard or s.hovering or (s.target and not climbing(s)):
                 return True
-            earlier = s.uav_id < self.uav_id
-            return earlier if not s.target or climbing(s) else True
+            return s.uav_id < self.uav_id  # a climb target, or where one on its way is now
 
         return [s.where for s in others if counts(s)]
 

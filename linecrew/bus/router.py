@@ -11,7 +11,7 @@ import logging
 import sys
 
 from linecrew.bus import DEFAULT_ROUTER, Bus
-from linecrew.process import Shutdown, common_parser, site_id, start
+from linecrew.process import DEFAULT_SITE, Shutdown, common_parser, start
 from proto.errors import Unavailable
 from proto.keys import KeySpace, Role
 
@@ -32,7 +32,7 @@ def main(argv: list[str] | None = None) -> int:
     except Unavailable as exc:
         log.error("router cannot start: %s", exc)
         return 1
-    site = site_id(args.site)
+    site = args.site or DEFAULT_SITE  # start() has read LINECREW_SITE into it
     with bus:
         bus.declare_token(KeySpace(site).alive(Role.ROUTER, args.id))
         log.info("router listening on %s", ", ".join(config.listen), extra={"site": site})

@@ -14,7 +14,7 @@ from onboard_agent import AgentConfig
 from onboard_agent.route import (
     SIDESTEP_M,
     ground_distance,
-    nearest_level,
+    level_below,
     next_leg,
     own_level,
 )
@@ -107,9 +107,9 @@ def test_a_uav_higher_than_its_flight_needs_crosses_at_a_level_of_its_own_below(
         for p, z in ((0, 11.5), (1, 11.8), (2, 11.8))
     ]
     assert [leg.z_m for leg in legs] == [11.0, 7.0, 9.0]  # levels 5/11, 7/13, 9/15
-    assert nearest_level(11.5, 10.0, 2, 3) == 11.5  # 9 is too low for this flight
+    assert level_below(11.5, 10.0, 2, 3) == 11.5  # 9 is too low for this flight
     for z in (9.0, 9.2, 8.8, 9.35):  # at (or just off) its level: that level
-        assert nearest_level(z, 3.0, 2, 3) == 9.0
+        assert level_below(z, 3.0, 2, 3) == 9.0
     across = next_leg(point(0, 0, 9.2), target, [person], CLEAR_M, layer=(2, 3))
     assert across == point(20, 0, 9.0)
 
