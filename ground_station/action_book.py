@@ -11,15 +11,9 @@ import msgspec
 from ground_station.event_log import EventLog
 from ground_station.lifecycle import TERMINAL, ActionEvent, next_state
 from ground_station.store import Store
-from proto.errors import RequestError
+from proto.errors import InvalidTransition, NotFound
 from proto.events import EventKind
 from proto.mission import ActionRecord, ActionState
-
-
-class NotFound(RequestError):
-    """An action id the ground station does not know. Do not retry."""
-
-    code = "not_found"
 
 
 class ActionBook:
@@ -41,11 +35,7 @@ class ActionBook:
         """The record of an action that has not ended (else invalid_transition)."""
         record = self.record(action_id)
         if record.state in TERMINAL:
-            raise RequestError(
-                f"action {action_id} is {record.state}",
-                code="invalid_transition",
-                field="action_id",
-            )
+            raise InvalidTransition(f"action {action_id} is {record.state}", field="action_id")
         return record
 
     def transition(self, record: ActionRecord, event: ActionEvent, reason: str) -> None:

@@ -11,18 +11,11 @@ from __future__ import annotations
 
 from collections.abc import Iterable
 
-from proto.errors import RequestError
+from proto.errors import ToolOutOfStock
 from proto.mission import ActionRecord, ActionState, DeliverAction
 from proto.site import Site
 
 RELEASED = frozenset({ActionState.FAILED, ActionState.CANCELLED})
-
-
-class OutOfStock(RequestError):
-    """Every copy of the tool at that station is delivered or reserved.
-    Choose another station or tool; retrying the same request is refused."""
-
-    code = "tool_out_of_stock"
 
 
 def stock_left(site: Site, records: Iterable[ActionRecord], station_id: str, tool: str) -> int:
@@ -41,11 +34,11 @@ def stock_left(site: Site, records: Iterable[ActionRecord], station_id: str, too
 
 
 def reserve(site: Site, records: Iterable[ActionRecord], action: DeliverAction) -> None:
-    """Raise :class:`OutOfStock` if ``action`` would take a tool that is not there."""
+    """Raise :class:`ToolOutOfStock` if ``action`` would take a tool that is not there."""
     if stock_left(site, records, action.tool_station_id, action.tool) <= 0:
         station = site.tool_station(action.tool_station_id)
         total = station.stock(action.tool) if station is not None else 0
-        raise OutOfStock(
+        raise ToolOutOfStock(
             f"no {action.tool} left at {action.tool_station_id}: all {total} delivered or "
             "reserved by other deliveries",
             field="action.tool",

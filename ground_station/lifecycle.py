@@ -14,7 +14,7 @@ from __future__ import annotations
 
 import enum
 
-from proto.errors import RequestError
+from proto.errors import InvalidTransition
 from proto.mission import ActionState as S
 
 
@@ -51,13 +51,6 @@ TRANSITIONS: dict[tuple[S, ActionEvent], S] = {
     (S.IN_PROGRESS, ActionEvent.IMPOSSIBLE): S.FAILED,
     (S.IN_PROGRESS, ActionEvent.CANCEL): S.CANCELLED,
 }
-
-
-class InvalidTransition(RequestError):
-    """An event that does not apply to the action's state (e.g. cancelling a
-    completed action). Raised by :func:`next_state`; the RPC caller gets it."""
-
-    code = "invalid_transition"
 
 
 def next_state(state: S, event: ActionEvent) -> S:

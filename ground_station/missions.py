@@ -32,28 +32,22 @@ from ground_station.plan_worker import PlanWorker
 from ground_station.replan_jobs import Computed, Job, ReplanOutcome
 from ground_station.replanner import Replanner
 from ground_station.store import Store, StoreUnavailable
-from ground_station.validation import InvalidAction, validate
-from proto.errors import RequestError
+from ground_station.validation import validate
+from proto.errors import Conflict, InvalidAction, NotFound
 from proto.events import EventKind
 from proto.mission import ActionRecord, ActionState, DeliverAction, MonitorAction
 from proto.plan import MonitorTask, Plan, WaitTask
 from proto.rpc import (
     ActionList,
-    ActionReply,
     CancelAction,
     Command,
     ControlUav,
     FleetReply,
-    GetAction,
-    GetFleet,
     GetHistory,
-    GetPlans,
     HistoryReply,
     ListActions,
     ModifyAction,
     PlansReply,
-    Reply,
-    Request,
     SubmitAction,
 )
 from proto.scenario import Scenario
@@ -63,12 +57,6 @@ log = logging.getLogger(__name__)
 
 RETRY_UNPLACED_S = 30.0
 """Mission seconds between retries of actions that no UAV could take yet."""
-
-
-class Conflict(RequestError):
-    """A request id reused for a different request. Use a new request id."""
-
-    code = "conflict"
 
 
 class MissionManager:
@@ -108,34 +96,18 @@ class MissionManager:
             battery_margin_fraction=battery_margin_fraction,
         )
 
-    # -- requests --------------------------------------------------------------
+    # -- requests (the gs's dispatch table, GroundStation.answers, calls these) --
 
-    def handle(self, request: Request) -> Reply:
-        """Answer one RPC request (raises a :class:`RequestError` to refuse)."""
-        match request:
-            case SubmitAction():
-                return ActionReply(record=self.submit(request))
-            case ModifyAction():
-                return ActionReply(record=self.modify(request))
-            case CancelAction():
-                return ActionReply(record=self.cancel(request))
-            case GetAction(action_id=action_id):
-                return ActionReply(record=self.book.record(action_id))
-            case ListActions(states=states, limit=limit, cursor=cursor):
-                records = self.store.actions(states)
-                shown, more = page(records, lambda r: r.action_id, cursor, limit)
-                return ActionList(records=shown, next_cursor=more)
-            case GetFleet():
-                return self.fleet()
-            case ControlUav():
-                self.control(request)
-                return self.fleet()
-            case GetPlans(uav_id=uav_id):
-                return self.plans(uav_id)
-            case GetHistory(after_seq=after, limit=limit):
-                events = fitting(self.events.after(after, limit))
-                return HistoryReply(events=events, last_seq=self.events.last_seq)
-        raise RequestError(f"unsupported request {type(request).__name__}")
+    def list_actions(self, request: ListActions) -> ActionList:
+        """Actions in ``request.states`` (all if none), a page at a time."""
+        records = self.store.actions(request.states)
+        shown, more = page(records, lambda r: r.action_id, request.cursor, request.limit)
+        return ActionList(records=shown, next_cursor=more)
+
+    def history(self, request: GetHistory) -> HistoryReply:
+        """Events after ``request.after_seq``, as many as fit one reply."""
+        events = fitting(self.events.after(request.after_seq, request.limit))
+        return HistoryReply(events=events, last_seq=self.events.last_seq)
 
     def plans(self, uav_id: str | None = None) -> PlansReply:
         """The current plans (of ``uav_id`` only, if given), with the live
@@ -153,13 +125,12 @@ class MissionManager:
         ]
         return FleetReply(uavs=uavs)
 
-    def control(self, request: ControlUav) -> None:
+    def control(self, request: ControlUav) -> FleetReply:
         """An operator's command for one UAV (or all): its work is replanned
-        to the others at once, and it gets the command's task."""
+        to the others at once, and it gets the command's task. Answers the
+        fleet as it is now."""
         if request.uav_id is not None and not self.monitor.known(request.uav_id):
-            raise RequestError(
-                f"no UAV {request.uav_id!r} in the fleet", code="not_found", field="uav_id"
-            )
+            raise NotFound(f"no UAV {request.uav_id!r} in the fleet", field="uav_id")
         targets = [request.uav_id] if request.uav_id else [u.id for u in self.scenario.fleet.uavs]
         control, now = self.replanner.control, self.clock()
         for uav_id in targets:
@@ -171,6 +142,7 @@ class MissionManager:
                 EventKind.UAV_CONTROL, uav_id=uav_id, detail=f"operator: {request.command}"
             )
         self.request_replan(f"operator: {request.command} {request.uav_id or 'all'}", stale=True)
+        return self.fleet()
 
     def plan_quality(self) -> dict[str, float | None]:
         """The live plan's objective (seconds: weight-averaged completion +

@@ -9,7 +9,7 @@ from typing import TypeVar
 
 import msgspec
 
-from proto.errors import RequestError
+from proto.errors import InvalidRequest
 
 T = TypeVar("T")
 
@@ -26,7 +26,7 @@ def page(
     if cursor is not None:
         ids = [key(item) for item in items]
         if cursor not in ids:
-            raise RequestError(f"unknown cursor {cursor!r}", code="invalid_request", field="cursor")
+            raise InvalidRequest(f"unknown cursor {cursor!r}", field="cursor")
         start = ids.index(cursor) + 1
     rest = items[start:]
     out = fitting(rest, limit)

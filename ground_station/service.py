@@ -29,9 +29,24 @@ from ground_station.replanner import Replanner
 from ground_station.store import Store
 from linecrew.bus import Bus
 from linecrew.process import Shutdown
-from proto.errors import RequestError
+from proto.errors import Forbidden
 from proto.keys import KeySpace, Role, UavTopic
-from proto.rpc import REQUEST_OPS, GetMetrics, GetPlans, MetricsReply, PlansReply, Reply, Request
+from proto.rpc import (
+    ActionReply,
+    CancelAction,
+    ControlUav,
+    GetAction,
+    GetFleet,
+    GetHistory,
+    GetMetrics,
+    GetPlans,
+    ListActions,
+    MetricsReply,
+    ModifyAction,
+    PlansReply,
+    Reply,
+    SubmitAction,
+)
 from proto.scenario import Scenario
 from proto.telemetry import AgentStatus, TaskOutcome, Telemetry
 
@@ -99,8 +114,8 @@ class GroundStation:
         """Serve until ``shutdown``; then undeclare everything and close the store."""
         keys, bus = self.keys, self.bus
         try:
-            for op in REQUEST_OPS:
-                bus.serve(keys.rpc(op), Request, self._rpc_handler(op))
+            for request_type, answer in self.answers().items():
+                bus.serve(keys.rpc(request_type.op), request_type, answer)
             bus.serve(keys.all_uavs(UavTopic.PLAN), GetPlans, self._plan_query, with_key=True)
             telemetry = bus.subscribe_async(keys.all_uavs(UavTopic.TELEMETRY), Telemetry)
             status = bus.subscribe_async(keys.all_uavs(UavTopic.STATUS), AgentStatus)
@@ -194,24 +209,30 @@ class GroundStation:
                 log.exception("traffic report not sent")
             await asyncio.sleep(self.traffic_period_s)
 
-    def _rpc_handler(self, op: str) -> Callable[[Request], Reply]:
-        def handle(request: Request) -> Reply:
-            if request.op != op:
-                raise RequestError(f"a {request.op!r} request sent to {op!r}", code="wrong_op")
-            if isinstance(request, GetMetrics):
-                return MetricsReply(values=self.metrics())
-            return self.manager.handle(request)
-
-        return handle
+    def answers(self) -> dict[type[Any], Callable[[Any], Reply]]:
+        """The one table from each operator request to its answer. Each is
+        served on ``gs/rpc/{op}`` and decoded as its own type only, so a
+        request sent to another operation's key is a ``decode_error``."""
+        m = self.manager
+        return {
+            SubmitAction: lambda r: ActionReply(record=m.submit(r)),
+            ModifyAction: lambda r: ActionReply(record=m.modify(r)),
+            CancelAction: lambda r: ActionReply(record=m.cancel(r)),
+            GetAction: lambda r: ActionReply(record=m.book.record(r.action_id)),
+            ListActions: m.list_actions,
+            GetFleet: lambda _: m.fleet(),
+            ControlUav: m.control,
+            GetPlans: lambda r: m.plans(r.uav_id),
+            GetHistory: m.history,
+            GetMetrics: lambda _: MetricsReply(values=self.metrics()),
+        }
 
     def _plan_query(self, key: str, request: GetPlans) -> PlansReply:
         """A UAV's plan, to the UAV whose key the query was sent to only."""
         parsed = self.keys.parse(key)  # a wildcard query is no UAV's: refused
         if parsed.kind != "uav" or not parsed.ident or request.uav_id not in (None, parsed.ident):
-            raise RequestError(
-                f"a query on {key} reads only the plan of {parsed.ident}",
-                code="forbidden",
-                field="uav_id",
+            raise Forbidden(
+                f"a query on {key} reads only the plan of {parsed.ident}", field="uav_id"
             )
         return self.manager.plans(parsed.ident)  # as an operator sees it
 

@@ -14,7 +14,7 @@ from typing import Any
 
 import msgspec
 
-from proto.errors import RequestError
+from proto.errors import InvalidAction
 from proto.fleet import Capability, Fleet
 from proto.mission import Action, DeliverAction, InspectAction, MonitorAction
 from proto.site import Site
@@ -22,14 +22,6 @@ from proto.site import Site
 MAX_RANGE_M = 100_000.0  # farther than any site: a typo, not a mission
 MAX_ALTITUDE_M = 1_000.0
 MAX_DURATION_S = 7 * 24 * 3600.0
-
-
-class InvalidAction(RequestError):
-    """An action that the site or fleet cannot accept (unknown worker, tool or
-    station, no capable UAV, out-of-range value). ``field`` names it; fix the
-    request, do not retry it as is."""
-
-    code = "invalid_action"
 
 
 def validate(action: Action, site: Site, fleet: Fleet, field: str = "action") -> None:

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import logging
 
-from proto.errors import RequestError
+from proto.errors import InvalidRequest, NotFound
 from proto.sim import (
     BatteryFault,
     DrainFault,
@@ -23,17 +23,13 @@ from sim_fleet.world import World
 log = logging.getLogger(__name__)
 
 
-class UnknownTarget(RequestError):
+class UnknownTarget(NotFound):
     """A fault aimed at a UAV or worker the simulator does not have. Fix the id."""
 
-    code = "not_found"
 
-
-class OutsideSite(RequestError):
+class OutsideSite(InvalidRequest):
     """A worker moved outside the site's area (``Site.area``): nobody works
     there, and no UAV may fly there to follow them."""
-
-    code = "invalid_request"
 
 
 def apply_fault(world: World, fault: SimFault, site: Site) -> FaultApplied:

@@ -25,7 +25,6 @@ from ground_station.gateway.bodies import (
     SubmitEnvelope,
 )
 from ground_station.gateway.errors import (
-    HttpError,
     decode_body,
     error_response,
     http_error_handler,
@@ -40,7 +39,7 @@ from ground_station.gateway.rpc import GsClient, to_json
 from ground_station.gateway.settings import GatewaySettings
 from ground_station.gateway.workers import WorkerPoses
 from proto.base import ID_PATTERN, MAX_INT, MAX_REQUEST_ID
-from proto.errors import LinecrewError, RequestTimeout
+from proto.errors import BodyTooLarge, InvalidRequest, LinecrewError, RequestTimeout
 from proto.mission import Action, ActionState
 from proto.rpc import (
     ActionList,
@@ -123,7 +122,7 @@ def create_app(
         async for chunk in request.stream():
             data += chunk
             if len(data) > settings.max_body_bytes:
-                raise HttpError("body_too_large", "request body too large")
+                raise BodyTooLarge("request body too large")
         return data
 
     async def submit(action: Action, request_id: str | None, action_id: str | None) -> Response:
@@ -133,8 +132,7 @@ def create_app(
         try:
             reply = await client.call(request, ActionReply)
         except RequestTimeout as exc:  # it may have been accepted: say how to find out
-            raise HttpError(
-                "request_timeout",
+            raise RequestTimeout(
                 f"{exc.message}; the action may have been accepted: send the same request "
                 "again with this request_id (it is never accepted twice)",
                 request_id=request.request_id,
@@ -153,8 +151,7 @@ def create_app(
         envelope = decode_body(raw, SubmitEnvelope)
         request_id = envelope.request_id or request.headers.get("idempotency-key")
         if request_id is not None and not 0 < len(request_id) <= MAX_REQUEST_ID:
-            raise HttpError(
-                "invalid_request",
+            raise InvalidRequest(
                 f"a request id has 1 to {MAX_REQUEST_ID} characters",
                 field="Idempotency-Key",
             )
@@ -318,7 +315,7 @@ def _states(text: str | None) -> list[ActionState]:
             states.append(ActionState(name))
         except ValueError:
             known = ", ".join(ActionState)
-            raise HttpError(
-                "invalid_request", f"unknown state {name!r} (one of {known})", field="state"
+            raise InvalidRequest(
+                f"unknown state {name!r} (one of {known})", field="state"
             ) from None
     return states

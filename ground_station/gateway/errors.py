@@ -1,5 +1,6 @@
-"""How linecrew errors become HTTP answers: one table from error code to
-status, one JSON shape ``{"error": code, "message": ..., "field": ...}``."""
+"""How linecrew errors become HTTP answers: the status is the error tree's
+(:data:`proto.errors.HTTP_STATUS`), the JSON shape is one,
+``{"error": code, "message": ..., "field": ...}``."""
 
 from __future__ import annotations
 
@@ -9,30 +10,11 @@ from fastapi.exceptions import RequestValidationError
 from fastapi.responses import JSONResponse
 from starlette.exceptions import HTTPException
 
-from proto.errors import LinecrewError
-
-STATUS_BY_CODE: dict[str, int] = {
-    "invalid_action": 422,
-    "decode_error": 422,
-    "invalid_request": 422,
-    "invalid_key": 422,
-    "unknown_gesture": 422,
-    "tool_out_of_stock": 422,
-    "not_found": 404,
-    "method_not_allowed": 405,
-    "conflict": 409,
-    "invalid_transition": 409,
-    "request_timeout": 503,
-    "encode_error": 503,  # the ground station's answer cannot go on the bus (too large)
-    "unavailable": 503,
-    "store_unavailable": 503,
-    "unauthorized": 401,
-    "body_too_large": 413,
-}
+from proto.errors import InvalidRequest, LinecrewError, http_status
 
 
 class ErrorBody(msgspec.Struct, frozen=True, kw_only=True):
-    """Every error answer: a code of :data:`STATUS_BY_CODE`, a sentence for
+    """Every error answer: a code of :data:`proto.errors.HTTP_STATUS`, a sentence for
     people and the request field at fault (null: the request as a whole)."""
 
     error: str
@@ -40,20 +22,10 @@ class ErrorBody(msgspec.Struct, frozen=True, kw_only=True):
     field: str | None = None
 
 
-class HttpError(LinecrewError):
-    """An error raised by the gateway itself (bad body, unknown gesture...)."""
-
-    def __init__(self, code: str, message: str, field: str | None = None, **extra: object):
-        super().__init__(message)
-        self.code = code
-        self.field = field
-        self.extra = extra
-
-
 def error_response(code: str, message: str, field: str | None = None, **extra: object):
     """The JSON error answer for ``code``."""
     body = {"error": code, "message": message, "field": field, **extra}
-    return JSONResponse(body, status_code=STATUS_BY_CODE.get(code, 500))
+    return JSONResponse(body, status_code=http_status(code))
 
 
 async def linecrew_error_handler(_request: Request, exc: Exception) -> JSONResponse:
@@ -90,7 +62,7 @@ def known_query_only(request: Request) -> None:
     unknown = sorted(set(request.query_params) - allowed)
     if unknown:
         name = unknown[0]
-        raise HttpError("invalid_request", f"unknown query parameter {name!r}", field=name)
+        raise InvalidRequest(f"unknown query parameter {name!r}", field=name)
 
 
 def decode_body(body: bytes, body_type: type) -> object:
@@ -99,6 +71,6 @@ def decode_body(body: bytes, body_type: type) -> object:
         return msgspec.json.decode(body, type=body_type)
     except msgspec.ValidationError as exc:
         field = str(exc).rsplit("at `$.", 1)[-1].rstrip("`") if "at `$." in str(exc) else None
-        raise HttpError("invalid_request", str(exc), field=field) from exc
+        raise InvalidRequest(str(exc), field=field) from exc
     except msgspec.DecodeError as exc:
-        raise HttpError("invalid_request", f"body is not valid JSON: {exc}") from exc
+        raise InvalidRequest(f"body is not valid JSON: {exc}") from exc

@@ -13,7 +13,7 @@ from typing import Literal
 
 import msgspec
 
-from ground_station.gateway.errors import HttpError
+from proto.errors import InvalidAction, UnknownGesture
 from proto.geo import Point
 from proto.mission import Action, DeliverAction, InspectAction, MonitorAction, WaypointSpec
 from proto.site import Site
@@ -50,8 +50,7 @@ class Vocabulary:
         """The action ``gesture`` at ``target`` asks for."""
         template = self.templates.get(gesture)
         if template is None:
-            raise HttpError(
-                "unknown_gesture",
+            raise UnknownGesture(
                 f"unknown gesture {gesture!r}",
                 field="gesture",
                 known=sorted(self.templates),
@@ -75,9 +74,7 @@ class Vocabulary:
             (s for s in site.tool_stations if template.tool in {t.name for t in s.tools}), None
         )
         if station is None:
-            raise HttpError(
-                "invalid_action", f"no tool station holds {template.tool!r}", field="gesture"
-            )
+            raise InvalidAction(f"no tool station holds {template.tool!r}", field="gesture")
         return DeliverAction(
             priority=template.priority,
             tool=template.tool,
@@ -88,14 +85,14 @@ class Vocabulary:
 
 def _worker(site: Site, worker_id: str) -> None:
     if site.worker(worker_id) is None:
-        raise HttpError("invalid_action", f"unknown worker {worker_id!r}", field="target")
+        raise InvalidAction(f"unknown worker {worker_id!r}", field="target")
 
 
 def _inspection_points(template: Template, target: str, site: Site) -> list[WaypointSpec]:
     towers = {t.id: t for t in site.towers}
     if template.target == "tower":
         if target not in towers:
-            raise HttpError("invalid_action", f"unknown tower {target!r}", field="target")
+            raise InvalidAction(f"unknown tower {target!r}", field="target")
         top = towers[target].position
         offsets = [(math.cos(a), math.sin(a)) for a in (0, math.pi / 2, math.pi, 3 * math.pi / 2)]
         points = [
@@ -109,7 +106,7 @@ def _inspection_points(template: Template, target: str, site: Site) -> list[Wayp
     else:
         line = next((line for line in site.lines if line.id == target), None)
         if line is None:
-            raise HttpError("invalid_action", f"unknown line {target!r}", field="target")
+            raise InvalidAction(f"unknown line {target!r}", field="target")
         points = [
             Point(
                 x_m=towers[t].position.x_m,

@@ -19,17 +19,10 @@ from typing import Any
 
 from ground_station.store.migrations import migrate
 from proto import codec
-from proto.errors import RequestError
+from proto.errors import StoreUnavailable
 from proto.events import GsEvent
 from proto.mission import ActionRecord, ActionState
 from proto.plan import Plan
-
-
-class StoreUnavailable(RequestError):
-    """The store cannot write (disk full, read-only, I/O error): nothing of
-    the request was kept. Retry once the disk is fixed (HTTP 503)."""
-
-    code = "store_unavailable"
 
 
 class Store:

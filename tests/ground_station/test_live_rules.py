@@ -10,7 +10,6 @@ import msgspec
 import pytest
 
 from ground_station.agent_reports import MAX_RETRYABLE_FAILURES
-from ground_station.inventory import OutOfStock
 from proto import (
     ActionState,
     AgentState,
@@ -32,6 +31,7 @@ from proto import (
     TaskOutcome,
     WaitTask,
 )
+from proto.errors import ToolOutOfStock
 from tests.ground_station.harness import ALL, Harness
 
 
@@ -125,7 +125,7 @@ def test_a_monitoring_segment_never_gets_the_id_of_one_already_flown(gs):
 def test_the_last_copy_of_a_tool_is_reserved_and_given_back_on_cancel(gs):
     wrench = DeliverAction(tool="wrench", tool_station_id="tp-wrench", worker_id="W1")
     submit(gs, wrench, "first")
-    with pytest.raises(OutOfStock) as refused:
+    with pytest.raises(ToolOutOfStock) as refused:
         submit(gs, msgspec.structs.replace(wrench, worker_id="W2"), "second")
     assert refused.value.code == "tool_out_of_stock" and refused.value.field == "action.tool"
     assert gs.store.action("second") is None

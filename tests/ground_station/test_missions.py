@@ -17,7 +17,6 @@ from proto import (
     ControlUav,
     EventKind,
     FlightState,
-    GetFleet,
     InspectTask,
     LandTask,
     ModifyAction,
@@ -267,12 +266,12 @@ def test_an_operator_command_takes_a_uav_out_of_the_plan_until_resume(gs):
     gs.submit("inspect-loop")
     plan, _ = _inspect_task(gs, "inspect-loop")
     held = plan.uav_id
-    gs.manager.handle(ControlUav(uav_id=held, command=Command.LAND))
+    gs.manager.control(ControlUav(uav_id=held, command=Command.LAND))
     gs.settle()
     [land] = gs.latest(held).tasks
     assert isinstance(land, LandTask)
     assert _inspect_task(gs, "inspect-loop")[0].uav_id != held  # its work went to another
-    fleet = {u.uav_id: u for u in gs.manager.handle(GetFleet()).uavs}
+    fleet = {u.uav_id: u for u in gs.manager.fleet().uavs}
     assert fleet[held].control == Command.LAND
     gs.manager.reports.on_outcome(
         TaskOutcome(
@@ -285,14 +284,14 @@ def test_an_operator_command_takes_a_uav_out_of_the_plan_until_resume(gs):
     gs.manager.request_replan("test")
     gs.settle()
     assert gs.replanner.plans[held].tasks == []  # landed: it waits for the operator
-    gs.manager.handle(ControlUav(command=Command.HOLD))  # every UAV: a fleet stop
+    gs.manager.control(ControlUav(command=Command.HOLD))  # every UAV: a fleet stop
     gs.settle()
     assert all(isinstance(gs.latest(u).tasks[0], WaitTask) for u in ALL)
     assert not _inspecting(gs, "inspect-loop")
-    gs.manager.handle(ControlUav(command=Command.RESUME))
+    gs.manager.control(ControlUav(command=Command.RESUME))
     gs.settle()
-    assert {u.control for u in gs.manager.handle(GetFleet()).uavs} == {None}
+    assert {u.control for u in gs.manager.fleet().uavs} == {None}
     assert _inspecting(gs, "inspect-loop")  # planned again
     with pytest.raises(RequestError) as unknown:
-        gs.manager.handle(ControlUav(uav_id="uav-9", command=Command.HOLD))
+        gs.manager.control(ControlUav(uav_id="uav-9", command=Command.HOLD))
     assert unknown.value.code == "not_found"

@@ -6,10 +6,14 @@ from __future__ import annotations
 
 import sys
 import time
+import types
+import typing
 from collections.abc import Iterable
+from unittest import mock
 
 import pytest
 
+from ground_station.service import GroundStation
 from linecrew.bench.light_agent import LightAgent
 from linecrew.bus import Bus
 from linecrew.scenarios import load
@@ -40,6 +44,7 @@ from proto import (
     UavTopic,
 )
 from proto.errors import LinecrewError
+from proto.rpc import Request
 from tests.support.processes import Process, running, wait_until
 
 SCENARIO = load("paper")
@@ -296,6 +301,11 @@ def test_kill_9_and_restart_loses_nothing_accepted(router, client, agents, gs, t
         assert restarted.stop() == 0, restarted.output()
 
 
+def test_every_request_of_the_contract_has_one_answer_in_the_dispatch_table():
+    stand_in = types.SimpleNamespace(manager=mock.Mock(), metrics=dict)
+    assert set(GroundStation.answers(stand_in)) == set(typing.get_args(Request))
+
+
 @pytest.mark.parametrize("payload", [b"", b"\xc1", b"\x81\xa4type\xa6submit", b"x" * 5000])
 def test_hostile_rpc_payloads_get_error_replies_and_the_gs_keeps_serving(client, gs, payload):
     for op in ("submit", "cancel", "history"):
@@ -303,7 +313,7 @@ def test_hostile_rpc_payloads_get_error_replies_and_the_gs_keeps_serving(client,
         assert len(replies) == 1 and replies[0].err is not None
     with pytest.raises(RequestError) as caught:
         client.query(KEYS.rpc("cancel"), GetHistory(), HistoryReply, 5.0)
-    assert caught.value.code == "wrong_op"
+    assert caught.value.code == "decode_error"  # each key decodes its own request type only
     metrics = client.query(KEYS.rpc("metrics"), GetMetrics(), MetricsReply, 5.0)
     assert "replans" in metrics.values
     assert gs.popen.poll() is None

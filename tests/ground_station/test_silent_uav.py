@@ -6,12 +6,12 @@ from __future__ import annotations
 
 from ground_station.fleet_monitor import SILENT_AFTER_S
 from linecrew.clock import time_of_day
-from proto import ActionState, AgentState, AgentStatus, EventKind, GetFleet, InspectTask
+from proto import ActionState, AgentState, AgentStatus, EventKind, InspectTask
 from tests.ground_station.harness import ALL
 
 
 def fleet(gs) -> dict:
-    return {u.uav_id: u for u in gs.manager.handle(GetFleet()).uavs}
+    return {u.uav_id: u for u in gs.manager.fleet().uavs}
 
 
 def test_a_silent_uav_s_tasks_are_unknown_until_it_is_heard_again(gs):
