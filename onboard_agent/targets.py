@@ -96,7 +96,10 @@ def monitor_slot(ctx: Context) -> Point | None:
     same bearing, clear of that UAV. Past its end, while the relief is not
     there (:func:`awaiting_relief`), it lies on the ring ``wait_aside_m``
     from the slot (counter-clockwise): the worker stays watched and the slot
-    is free for the relief to close in on."""
+    is free for the relief to close in on. Past its end with a relief named
+    and not awaited (it is there, or waited for too long) it is where the UAV
+    is: the UAV leaves from there, never back into the slot (chaos seed 11:
+    a relieved UAV flew back in and passed 0.98 m under its relief)."""
     task = ctx.mission.head
     if not isinstance(task, MonitorTask):
         return None
@@ -105,6 +108,8 @@ def monitor_slot(ctx: Context) -> Point | None:
         turn_deg = 2.0 * math.degrees(math.asin(chord))
         turned = msgspec.structs.replace(task, bearing_deg=task.bearing_deg + turn_deg)
         return _ring_point(ctx, turned, task.standoff_m)
+    if task.relieved_by is not None and 0 < task.end_s <= ctx.wall():
+        return ctx.vehicle.position if ctx.surroundings.worker_position(task.worker_id) else None
     return _slot_point(ctx, task)
 
 

@@ -234,10 +234,15 @@ def test_a_relieved_uav_watches_from_beside_its_slot_until_its_relief_is_there()
     assert beside.z_m == pytest.approx(slot.z_m)
     assert beside.distance_to(slot) == pytest.approx(config.wait_aside_m)  # the slot left free
     assert beside.distance_to(slot) > config.keep_clear_m  # so the relief does not hold off
+    sent = len(rig.autopilot.calls)
     _traffic_at(rig, point(slot.x_m + config.handover_hold_m, slot.y_m, slot.z_m))  # closing in
     rig.run_until(lambda: rig.mission.head is None)
     [outcome] = rig.outcomes()
     assert outcome.result is OutcomeResult.COMPLETED
+    # it leaves from where it is: never back into the slot its relief closes in on (chaos
+    # seed 11: a relieved UAV flew back to the slot and passed 0.98 m under its relief)
+    back = [a for n, a in rig.autopilot.calls[sent:] if n == "goto" and a.distance_to(slot) < 2.0]
+    assert back == []
 
 
 def test_a_relief_that_never_comes_is_waited_for_at_most_relief_wait_s():
