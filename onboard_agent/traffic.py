@@ -19,6 +19,7 @@ from __future__ import annotations
 import math
 from typing import NamedTuple
 
+from onboard_agent.route import ground_distance
 from onboard_agent.surroundings import horizontal_distance
 from proto.geo import Point
 from proto.telemetry import Traffic as TrafficReport
@@ -121,7 +122,7 @@ class Traffic:
             None,
         )
 
-    def obstacles(self, now_s: float) -> list[Point]:
+    def obstacles(self, now_s: float, track: tuple[Point, Point] | None = None) -> list[Point]:
         """Where other airborne UAVs hover or are about to: heard at their
         target, the targets they fly to, and where those unheard for
         ``UNHEARD_S`` were heard. Chaos seeds 14 and 17: a UAV crossing
@@ -131,9 +132,12 @@ class Traffic:
         The point a heard UAV climbs to counts only for UAVs after it in id
         order: two UAVs climbing side by side, each over the other's climb
         target, went on raising their crossings to 695 m (chaos seed 12).
-        So does where a heard UAV on its way is now: of two UAVs whose
-        tracks cross, the later in id order crosses over the other, which
-        flies on (chaos seed 20: two swapping slots met head on at 6 m)."""
+        So does where a heard UAV on its way is now and, given this UAV's
+        own ``track`` (from, to), the point of the other's track nearest it:
+        of two UAVs whose tracks cross, the later in id order crosses over
+        the other, which flies on (chaos seed 20: two swapping slots met
+        head on at 6 m; seed 17: two re-routed mid-climb to targets at one
+        height crossed there, each already past where the other was heard)."""
         others = self._others(now_s)
         heard = {s.uav_id: s.where for s in others if not s.target}
 
@@ -146,7 +150,14 @@ class Traffic:
                 return True
             return s.uav_id < self.uav_id  # a climb target, or where one on its way is now
 
-        return [s.where for s in others if counts(s)]
+        out = [s.where for s in others if counts(s)]
+        if track is not None:
+            out += [
+                _nearest_on(heard[s.uav_id], s.where, *track)
+                for s in others
+                if s.target and not s.unheard and s.uav_id < self.uav_id and s.uav_id in heard
+            ]
+        return out
 
     def _others(self, now_s: float) -> list[Sighting]:
         """Where the other airborne UAVs of the report may be: where each
@@ -165,6 +176,34 @@ class Traffic:
             if e.target is not None:
                 out.append(Sighting(e.uav_id, e.target, unheard, target=True))
         return out
+
+
+def _nearest_on(a: Point, b: Point, c: Point, d: Point) -> Point:
+    """The point of track ``a``-``b`` (its height interpolated) nearest,
+    horizontally, to track ``c``-``d``: at an end of either, or where the
+    two cross."""
+    ax, ay, bx, by = a.x_m, a.y_m, b.x_m, b.y_m
+    ux, uy = bx - ax, by - ay
+    length2 = ux * ux + uy * uy
+    if length2 == 0.0:
+        return a
+
+    def along(x: float, y: float) -> float:
+        return max(0.0, min(1.0, ((x - ax) * ux + (y - ay) * uy) / length2))
+
+    candidates = [0.0, 1.0, along(c.x_m, c.y_m), along(d.x_m, d.y_m)]
+    vx, vy = d.x_m - c.x_m, d.y_m - c.y_m
+    cross = ux * vy - uy * vx
+    if cross != 0.0:
+        t = ((c.x_m - ax) * vy - (c.y_m - ay) * vx) / cross
+        u = ((c.x_m - ax) * uy - (c.y_m - ay) * ux) / cross
+        if 0.0 <= t <= 1.0 and 0.0 <= u <= 1.0:
+            candidates.append(t)
+
+    def at(t: float) -> Point:
+        return Point(x_m=ax + t * ux, y_m=ay + t * uy, z_m=a.z_m + t * (b.z_m - a.z_m))
+
+    return min((at(t) for t in candidates), key=lambda q: ground_distance(q, c, d))
 
 
 def _coming(where: Point, target: Point, point: Point, radius_m: float) -> bool:

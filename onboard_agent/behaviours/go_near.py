@@ -166,7 +166,7 @@ class GoNear(AgentBehaviour):
         if held is not None:
             return held
         clear_m = ctx.surroundings.site.safety.people_clearance_m + config.route_margin_m
-        traffic = ctx.traffic.obstacles(ctx.link_clock())
+        traffic = ctx.traffic.obstacles(ctx.link_clock(), (vehicle.position, point))
         obstacles = (
             ctx.surroundings.people() + ctx.spots.raised_spots(ctx.surroundings.site) + traffic
         )

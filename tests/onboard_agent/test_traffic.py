@@ -133,3 +133,44 @@ def test_of_two_uavs_whose_tracks_cross_the_later_in_id_order_crosses_over():
     leg = next_leg(uav2_at, uav2_to, seen["uav-2"].obstacles(0.0), clear, layer=(1, 3))
     assert (leg.x_m, leg.y_m) == (uav2_at.x_m, uav2_at.y_m)  # up first, where it is
     assert leg.z_m >= uav1_at.z_m + clear
+
+
+def test_the_later_uav_crosses_over_the_track_of_an_earlier_one_not_only_where_it_was():
+    """Chaos seed 17: uav-1 and uav-2, re-routed mid-climb out of C2 to
+    targets at one height, crossed there 0.97 m apart: where uav-1 was heard
+    lay 3 m off uav-2's track, but uav-1's track crossed it. The point of
+    uav-1's track nearest uav-2's is an obstacle for uav-2 (given its track)."""
+    uav1_at, uav1_to = p(-0.3, 19.1, 12.5), p(7.0, 10.0, 12.4)
+    uav2_at, uav2_to = p(2.9, 19.7, 12.7), p(2.0, 15.0, 12.4)
+    uavs = [
+        TrafficEntry(uav_id="uav-1", position=uav1_at, airborne=True, target=uav1_to),
+        TrafficEntry(uav_id="uav-2", position=uav2_at, airborne=True, target=uav2_to),
+    ]
+    seen = {}
+    for me in ("uav-1", "uav-2"):
+        seen[me] = Traffic(me)
+        seen[me].update(TrafficReport(uavs=uavs), 0.0)
+    clear = 2.5
+    where_heard_only = seen["uav-2"].obstacles(0.0)
+    assert next_leg(uav2_at, uav2_to, where_heard_only, clear, layer=(1, 3)) == uav2_to
+    crossing = seen["uav-2"].obstacles(0.0, (uav2_at, uav2_to))
+    leg = next_leg(uav2_at, uav2_to, crossing, clear, layer=(1, 3), traffic=crossing)
+    assert (leg.x_m, leg.y_m) == (uav2_at.x_m, uav2_at.y_m)  # up first, where it is
+    assert leg.z_m >= 12.4 + clear
+    mine = seen["uav-1"].obstacles(0.0, (uav1_at, uav1_to))  # uav-2's target is on its way
+    assert next_leg(uav1_at, uav1_to, mine, clear, layer=(0, 3), traffic=mine).z_m != leg.z_m
+
+
+@pytest.mark.parametrize(
+    ("track", "nearest"),
+    [
+        ((p(0, -5, 0), p(0, 5, 0)), p(0, 0, 7)),  # crossing: where they cross, height between
+        ((p(20, 3, 0), p(30, 3, 0)), p(10, 0, 8)),  # beyond its end: its end
+        ((p(4, 8, 0), p(4, 2, 0)), p(4, 0, 7.4)),  # ends short of it: the projection
+    ],
+)
+def test_the_nearest_point_of_another_track_to_mine(track, nearest):
+    from onboard_agent.traffic import _nearest_on
+
+    got = _nearest_on(p(-10, 0, 6), p(10, 0, 8), *track)
+    assert got.distance_to(nearest) < 1e-9
