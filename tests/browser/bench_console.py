@@ -1,7 +1,7 @@
 """Frame times of the operator console under a 50-UAV, 5 Hz feed.
 
 ``python -m tests.browser.bench_console [--uavs 50] [--rate 5] [--seconds 10]``
-serves the real gateway app over a fake fleet (:mod:`tests.browser.fake_fleet`),
+serves the real gateway app over a fake fleet (:mod:`tests.fakes.fleet`),
 opens the console in chromium polling the fleet at the feed's rate, and
 prints the requestAnimationFrame deltas (max, p99, mean) and the console's
 own render time per frame. It measures; it asserts nothing about speed.
@@ -15,7 +15,7 @@ import statistics
 import sys
 import time
 
-from tests.browser.fake_fleet import TOKEN, fake_app, serving
+from tests.fakes.fleet import TOKEN, fake_app, serving
 
 FRAME_PROBE = """
 window.__frames = [];

@@ -10,7 +10,7 @@ import pytest
 
 from linecrew.fault_kinds import FAULT_KINDS
 from proto.sim import SimFault
-from tests.browser.fake_fleet import TOKEN, big_site, fake_app, serving
+from tests.fakes.fleet import TOKEN, big_site, fake_app, serving
 
 
 @pytest.fixture(scope="module")

@@ -9,7 +9,7 @@ from __future__ import annotations
 import json
 
 from tests.browser.bench_console import measure, report
-from tests.browser.fake_fleet import fake_app, serving
+from tests.fakes.fleet import fake_app, serving
 
 UAVS = 50
 RATE_HZ = 5.0

@@ -17,7 +17,7 @@ import pytest
 from ground_station.gateway import console
 from ground_station.gateway.rpc import to_json
 from linecrew.scenarios import load
-from tests.browser.fake_fleet import TOKEN, fake_app, serving
+from tests.fakes.fleet import TOKEN, fake_app, serving
 
 ROOT = Path(__file__).resolve().parents[2]
 STATIC = ROOT / "ground_station" / "gateway" / "console" / "static"

@@ -10,7 +10,7 @@ from onboard_agent import Agent, AgentConfig
 from proto.geo import Point
 from proto.plan import InspectTask, Plan, Task, Waypoint
 from proto.spots import spot_owners, spot_positions
-from tests.onboard_agent.fakes import FakeAutopilot, FakeClock
+from tests.fakes.autopilot import FakeAutopilot, FakeClock
 
 SCENARIO = load("paper")
 TICK_S = 0.1

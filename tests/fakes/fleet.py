@@ -2,7 +2,9 @@
 circles whose telemetry changes ``rate_hz`` times a second, a plan per UAV
 whose epoch moves every few seconds (with a ``plan_changed`` event on the
 stream). For the console's serving tests and its frame-time bench, where a
-real 50-UAV fleet would measure the simulator rather than the page."""
+real 50-UAV fleet would measure the simulator rather than the page, and for
+the gateway's in-process tests (:attr:`FakeClient.refusal` makes the next
+request fail as the ground station would refuse it)."""
 
 from __future__ import annotations
 
@@ -22,6 +24,7 @@ from ground_station.gateway import GatewaySettings, Vocabulary, create_app
 from ground_station.gateway.workers import WorkerPoses
 from linecrew.bus.router_process import free_port
 from proto import KeySpace
+from proto.errors import LinecrewError, NotFound
 from proto.events import EventKind, GsEvent
 from proto.geo import GeoPoint, Point
 from proto.mission import ActionRecord, ActionState
@@ -232,8 +235,14 @@ class FakeClient:
         self.bus = _Bus(fleet)
         self.actions: dict[str, ActionRecord] = {}
         self.faults: list[SimFault] = []
+        self.refusal: LinecrewError | None = None  # raised by the next request, once
+        self.requests: list[Any] = []
 
     async def call(self, request: Any, _reply_type: Any = None) -> Any:
+        self.requests.append(request)
+        refusal, self.refusal = self.refusal, None
+        if refusal is not None:
+            raise refusal
         match request:
             case GetFleet():
                 return FleetReply(uavs=self.fleet.fleet())
@@ -241,6 +250,8 @@ class FakeClient:
                 return PlansReply(plans=self.fleet.plans())
             case ListActions():
                 return ActionList(records=list(self.actions.values()))
+            case GetAction(action_id=action_id) if action_id not in self.actions:
+                raise NotFound(f"no action {action_id!r}", field="action_id")
             case GetAction():
                 return ActionReply(record=self.actions[request.action_id])
             case SubmitAction():
