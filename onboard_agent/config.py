@@ -43,6 +43,7 @@ class AgentConfig(EnvSettings):
     keep_clear_m: float = 2.0  # never fly to a point another airborne UAV is this near (traffic)
     yield_max_s: float = 30.0  # hold off at most this long (mission s), then fly on
     relief_wait_s: float = 60.0  # past its segment's end, wait this long at most for the relief
+    relief_there_m: float = 1.5  # a relief heard this near its slot (3-D) has taken it over
     goto_resend_s: float = 1.0  # repeat a position target this often (no ACK exists)
     task_attempts: int = 3  # a task whose subtree failed this often is reported failed
     arm_attempts: int = 6  # arm / mode / takeoff refusals retried (with backoff) before failing

@@ -121,8 +121,9 @@ def _slot_point(ctx: Context, task: MonitorTask) -> Point | None:
 
 def awaiting_relief(ctx: Context) -> bool:
     """Whether the head segment is past its end and the relief it names is
-    not at the slot yet (not within ``handover_hold_m`` + ``near_slot_m``
-    of it in the traffic report), for at most ``relief_wait_s``."""
+    not at the slot yet (not within ``relief_there_m`` of it in the traffic
+    report: one holding farther out, or coming down from above, is not
+    watching yet), for at most ``relief_wait_s``."""
     task, config = ctx.mission.head, ctx.config
     if not isinstance(task, MonitorTask) or task.relieved_by is None or task.end_s <= 0:
         return False
@@ -130,8 +131,7 @@ def awaiting_relief(ctx: Context) -> bool:
         return False
     slot = _slot_point(ctx, task)
     there = ctx.traffic.position(task.relieved_by, ctx.link_clock())
-    near_m = config.handover_hold_m + config.near_slot_m
-    return slot is not None and (there is None or there.distance_to(slot) > near_m)
+    return slot is not None and (there is None or there.distance_to(slot) > config.relief_there_m)
 
 
 def wait_aside(ctx: Context) -> Point | None:

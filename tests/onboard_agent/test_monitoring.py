@@ -234,8 +234,12 @@ def test_a_relieved_uav_watches_from_beside_its_slot_until_its_relief_is_there()
     assert beside.z_m == pytest.approx(slot.z_m)
     assert beside.distance_to(slot) == pytest.approx(config.wait_aside_m)  # the slot left free
     assert beside.distance_to(slot) > config.keep_clear_m  # so the relief does not hold off
-    sent = len(rig.autopilot.calls)
     _traffic_at(rig, point(slot.x_m + config.handover_hold_m, slot.y_m, slot.z_m))  # closing in
+    _traffic_at(rig, point(slot.x_m, slot.y_m, slot.z_m + 2.5))  # or coming down: not there yet
+    rig.tick(5)
+    assert rig.mission.head == task and last_goto(rig) == beside
+    sent = len(rig.autopilot.calls)
+    _traffic_at(rig, point(slot.x_m + 1.0, slot.y_m, slot.z_m))  # at the slot: it leaves
     rig.run_until(lambda: rig.mission.head is None)
     [outcome] = rig.outcomes()
     assert outcome.result is OutcomeResult.COMPLETED
