@@ -69,6 +69,7 @@ def next_leg(
     columns: Iterable[Point] = (),
     layer: tuple[int, int] | None = None,
     traffic: Iterable[Point] = (),
+    ahead: Iterable[Point] = (),
 ) -> Point:
     """The point to send the autopilot now on the way from ``here`` to
     ``target``; with ``cruise_z`` the flight is legged anyway and crosses
@@ -82,11 +83,13 @@ def next_leg(
     ``traffic`` (among ``people`` too) are where other UAVs are or are
     about to be: a climb or descent first moves level clear of them
     (:func:`_sidestep`); people beside a target are not, a drop is above one.
-    A UAV beside the target is crossed above like a person on the way when
-    the track passes over it (nearer than ``SIDESTEP_M``): chaos seed 20, a
-    UAV flying to its spot passed level over one hovering above the next."""
+    Of those, ``ahead`` are where another UAV stays (hovers, or is about
+    to) or has yet to pass: one beside the target is crossed above like a
+    person on the way when the track passes over it (nearer than
+    ``SIDESTEP_M``; chaos seed 20: a UAV flying to its spot passed level
+    over one hovering above the next). Where one on its way is now (a UAV
+    leaving the slot its relief flies to) is not."""
     low = min(here.z_m, target.z_m)
-    traffic = list(traffic)
 
     def near(points: Iterable[Point]) -> list[Point]:
         return [
@@ -101,9 +104,7 @@ def next_leg(
     near_people, near_columns = near(people), near(columns)
     if not near_people and not near_columns and cruise_z is None:
         return target
-    passed_over = [
-        p for p in traffic if ground_distance(p, here, target) < SIDESTEP_M - TOLERANCE_M
-    ]
+    passed_over = [p for p in ahead if ground_distance(p, here, target) < SIDESTEP_M - TOLERANCE_M]
     beside_target = [
         p
         for p in near_people

@@ -140,24 +140,38 @@ class Traffic:
         height crossed there, each already past where the other was heard)."""
         others = self._others(now_s)
         heard = {s.uav_id: s.where for s in others if not s.target}
+        out = [
+            s.where
+            for s in others
+            if _stays(s, heard) or s.uav_id < self.uav_id  # a climb target, or where one is now
+        ]
+        return out + self._tracks(others, heard, track)
 
-        def climbing(s: Sighting) -> bool:
-            where = heard.get(s.uav_id)
-            return where is not None and s.where.z_m > where.z_m + HOVER_M
+    def ahead(self, now_s: float, track: tuple[Point, Point] | None = None) -> list[Point]:
+        """The obstacles another UAV stays at (:func:`_stays`) or has yet to
+        reach on its track, not where one on its way is now (it moves on:
+        a UAV leaving the slot its relief flies to)."""
+        others = self._others(now_s)
+        heard = {s.uav_id: s.where for s in others if not s.target}
+        stays = [s.where for s in others if _stays(s, heard)]
+        return stays + [
+            p
+            for p in self._tracks(others, heard, track)
+            if all(p.distance_to(where) >= HOVER_M for where in heard.values())
+        ]
 
-        def counts(s: Sighting) -> bool:
-            if s.unheard or s.hovering or (s.target and not climbing(s)):
-                return True
-            return s.uav_id < self.uav_id  # a climb target, or where one on its way is now
-
-        out = [s.where for s in others if counts(s)]
-        if track is not None:
-            out += [
-                _nearest_on(heard[s.uav_id], s.where, *track)
-                for s in others
-                if s.target and not s.unheard and s.uav_id < self.uav_id and s.uav_id in heard
-            ]
-        return out
+    def _tracks(
+        self, others: list[Sighting], heard: dict[str, Point], track: tuple[Point, Point] | None
+    ) -> list[Point]:
+        """Of each UAV before this one in id order heard on its way, the
+        point of its track nearest ``track``."""
+        if track is None:
+            return []
+        return [
+            _nearest_on(heard[s.uav_id], s.where, *track)
+            for s in others
+            if s.target and not s.unheard and s.uav_id < self.uav_id and s.uav_id in heard
+        ]
 
     def _others(self, now_s: float) -> list[Sighting]:
         """Where the other airborne UAVs of the report may be: where each
@@ -176,6 +190,17 @@ class Traffic:
             if e.target is not None:
                 out.append(Sighting(e.uav_id, e.target, unheard, target=True))
         return out
+
+
+def _stays(s: Sighting, heard: dict[str, Point]) -> bool:
+    """Whether another UAV stays at ``s``: heard hovering there, unheard
+    (its autopilot holds its last target), or the target it flies to, unless
+    a climb (``heard`` maps each UAV to where it was heard)."""
+    if s.unheard or s.hovering:
+        return True
+    where = heard.get(s.uav_id)
+    climbing = where is not None and s.where.z_m > where.z_m + HOVER_M
+    return s.target and not climbing
 
 
 def _nearest_on(a: Point, b: Point, c: Point, d: Point) -> Point:

@@ -166,15 +166,17 @@ class GoNear(AgentBehaviour):
         if held is not None:
             return held
         clear_m = ctx.surroundings.site.safety.people_clearance_m + config.route_margin_m
-        traffic = ctx.traffic.obstacles(ctx.link_clock(), (vehicle.position, point))
+        track = (vehicle.position, point)
+        traffic = ctx.traffic.obstacles(ctx.link_clock(), track)
         obstacles = (
             ctx.surroundings.people() + ctx.spots.raised_spots(ctx.surroundings.site) + traffic
         )
         columns = ctx.spots.busy_columns(ctx.surroundings.site, config.approach_alt_m)
         cruise_z = self.target.cruise_z(ctx)
         layer = ctx.spots.layer
+        ahead = ctx.traffic.ahead(ctx.link_clock(), track)
         leg = route.next_leg(
-            vehicle.position, point, obstacles, clear_m, cruise_z, columns, layer, traffic
+            vehicle.position, point, obstacles, clear_m, cruise_z, columns, layer, traffic, ahead
         )
         moved = self._sent is None or self._sent.distance_to(leg) > config.follow_threshold_m
         if moved or now - self._sent_at >= config.goto_resend_s:

@@ -188,7 +188,11 @@ def test_a_uav_beside_the_target_that_the_track_passes_over_is_crossed_above():
     spot, where uav-1 hovered 0.3 m higher before landing (0.93 m apart)."""
     here, spot = point(-7, 21, 11.5), point(3, 20, 11.5)
     hovering = point(1, 20, 11.8)  # 2 m from the spot, under the track
-    leg = next_leg(here, spot, [hovering], CLEAR_M, layer=(1, 3), traffic=[hovering])
+    leg = next_leg(
+        here, spot, [hovering], CLEAR_M, layer=(1, 3), traffic=[hovering], ahead=[hovering]
+    )
     assert (leg.x_m, leg.y_m) == (here.x_m, here.y_m) and leg.z_m >= hovering.z_m + CLEAR_M
     aside = point(3, 22, 11.8)  # beside the spot, off the track: still not crossed over
-    assert next_leg(here, spot, [aside], CLEAR_M, layer=(1, 3), traffic=[aside]) == spot
+    assert (
+        next_leg(here, spot, [aside], CLEAR_M, layer=(1, 3), traffic=[aside], ahead=[aside]) == spot
+    )

@@ -154,11 +154,16 @@ def test_the_later_uav_crosses_over_the_track_of_an_earlier_one_not_only_where_i
     where_heard_only = seen["uav-2"].obstacles(0.0)
     assert next_leg(uav2_at, uav2_to, where_heard_only, clear, layer=(1, 3)) == uav2_to
     crossing = seen["uav-2"].obstacles(0.0, (uav2_at, uav2_to))
-    leg = next_leg(uav2_at, uav2_to, crossing, clear, layer=(1, 3), traffic=crossing)
+    ahead = seen["uav-2"].ahead(0.0, (uav2_at, uav2_to))
+    leg = next_leg(uav2_at, uav2_to, crossing, clear, layer=(1, 3), traffic=crossing, ahead=ahead)
     assert (leg.x_m, leg.y_m) == (uav2_at.x_m, uav2_at.y_m)  # up first, where it is
     assert leg.z_m >= 12.4 + clear
     mine = seen["uav-1"].obstacles(0.0, (uav1_at, uav1_to))  # uav-2's target is on its way
-    assert next_leg(uav1_at, uav1_to, mine, clear, layer=(0, 3), traffic=mine).z_m != leg.z_m
+    theirs = seen["uav-1"].ahead(0.0, (uav1_at, uav1_to))
+    assert (
+        next_leg(uav1_at, uav1_to, mine, clear, layer=(0, 3), traffic=mine, ahead=theirs).z_m
+        != leg.z_m
+    )
 
 
 @pytest.mark.parametrize(
@@ -174,3 +179,24 @@ def test_the_nearest_point_of_another_track_to_mine(track, nearest):
 
     got = _nearest_on(p(-10, 0, 6), p(10, 0, 8), *track)
     assert got.distance_to(nearest) < 1e-9
+
+
+def test_a_relief_is_not_sent_over_the_slot_the_uav_it_relieves_is_leaving():
+    """The 1,500 s hand-over: a relief made to cross over the slot it flies
+    to (the UAV it relieves, earlier in id order, heard leaving it) came in
+    from above, and nobody watched the worker for 9 s."""
+    aside, hold = p(0.0, 3.0, 6.0), p(3.0, 0.0, 6.0)  # along the ring, and out on the bearing
+    relieved = TrafficEntry(uav_id="uav-1", position=SLOT, airborne=True, target=aside)
+    relief = Traffic("uav-2")
+    relief.update(TrafficReport(uavs=[relieved]), 0.0)
+    track = (hold, SLOT)
+    obstacles, ahead = relief.obstacles(0.0, track), relief.ahead(0.0, track)
+    assert SLOT in obstacles and SLOT not in ahead and aside in ahead
+    assert (
+        next_leg(hold, SLOT, obstacles, 2.5, layer=(1, 3), traffic=obstacles, ahead=ahead) == SLOT
+    )
+    hovering = msgspec.structs.replace(relieved, target=SLOT)  # staying there: crossed above
+    relief.update(TrafficReport(uavs=[hovering]), 0.0)
+    obstacles, ahead = relief.obstacles(0.0, track), relief.ahead(0.0, track)
+    leg = next_leg(hold, SLOT, obstacles, 2.5, layer=(1, 3), traffic=obstacles, ahead=ahead)
+    assert leg.z_m >= SLOT.z_m + 2.5
