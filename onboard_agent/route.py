@@ -70,6 +70,7 @@ def next_leg(
     layer: tuple[int, int] | None = None,
     traffic: Iterable[Point] = (),
     ahead: Iterable[Point] = (),
+    climbers: Iterable[Point] = (),
 ) -> Point:
     """The point to send the autopilot now on the way from ``here`` to
     ``target``; with ``cruise_z`` the flight is legged anyway and crosses
@@ -88,7 +89,10 @@ def next_leg(
     person on the way when the track passes over it (nearer than
     ``SIDESTEP_M``; chaos seed 20: a UAV flying to its spot passed level
     over one hovering above the next). Where one on its way is now (a UAV
-    leaving the slot its relief flies to) is not."""
+    leaving the slot its relief flies to) is not. ``climbers`` are where
+    UAVs climbing straight up are (those whose climb targets this UAV does
+    not cross over): a leg across one's column within its height band waits,
+    holding where the UAV is, until it has climbed clear (:func:`_across`)."""
     low = min(here.z_m, target.z_m)
 
     def near(points: Iterable[Point]) -> list[Point]:
@@ -103,7 +107,7 @@ def next_leg(
 
     near_people, near_columns = near(people), near(columns)
     if not near_people and not near_columns and cruise_z is None:
-        return target
+        return _across(here, target, climbers, clear_m)
     passed_over = [p for p in ahead if ground_distance(p, here, target) < SIDESTEP_M - TOLERANCE_M]
     beside_target = [
         p
@@ -124,7 +128,20 @@ def next_leg(
     if here.z_m < crossing - TOLERANCE_M:
         up = Point(x_m=here.x_m, y_m=here.y_m, z_m=crossing)
         return _sidestep(here, target, traffic, crossing) or up
-    return Point(x_m=target.x_m, y_m=target.y_m, z_m=crossing)
+    return _across(here, Point(x_m=target.x_m, y_m=target.y_m, z_m=crossing), climbers, clear_m)
+
+
+def _across(here: Point, leg: Point, climbers: Iterable[Point], clear_m: float) -> Point:
+    """``leg``, or where the UAV is while the leg would pass within
+    ``clear_m`` of a climber's column (horizontally) with the climber within
+    ``clear_m`` of the leg's height band: chaos seed 14, a UAV re-routed
+    mid-climb flew level across the column of one climbing beside it out
+    of the next spot (0.88 m)."""
+    low, high = min(here.z_m, leg.z_m) - clear_m, max(here.z_m, leg.z_m) + clear_m
+    for c in climbers:
+        if ground_distance(c, here, leg) < clear_m and low < c.z_m < high:
+            return here
+    return leg
 
 
 def _sidestep(here: Point, target: Point, obstacles: Iterable[Point], to_z: float) -> Point | None:

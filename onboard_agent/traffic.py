@@ -160,6 +160,22 @@ class Traffic:
             if all(p.distance_to(where) >= HOVER_M for where in heard.values())
         ]
 
+    def climbers(self, now_s: float) -> list[Point]:
+        """Where the UAVs after this one in id order that climb straight up
+        are (their climb targets are not obstacles for this UAV: it waits
+        for them to climb clear instead, :func:`onboard_agent.route.next_leg`)."""
+        others = self._others(now_s)
+        heard = {s.uav_id: s.where for s in others if not s.target and not s.unheard}
+        return [
+            heard[s.uav_id]
+            for s in others
+            if s.target
+            and s.uav_id > self.uav_id
+            and s.uav_id in heard
+            and s.where.z_m > heard[s.uav_id].z_m + HOVER_M
+            and horizontal_distance(s.where, heard[s.uav_id]) < HOVER_M
+        ]
+
     def _tracks(
         self, others: list[Sighting], heard: dict[str, Point], track: tuple[Point, Point] | None
     ) -> list[Point]:

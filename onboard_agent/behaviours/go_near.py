@@ -175,8 +175,18 @@ class GoNear(AgentBehaviour):
         cruise_z = self.target.cruise_z(ctx)
         layer = ctx.spots.layer
         ahead = ctx.traffic.ahead(ctx.link_clock(), track)
+        climbers = ctx.traffic.climbers(ctx.link_clock())
         leg = route.next_leg(
-            vehicle.position, point, obstacles, clear_m, cruise_z, columns, layer, traffic, ahead
+            vehicle.position,
+            point,
+            obstacles,
+            clear_m,
+            cruise_z,
+            columns,
+            layer,
+            traffic,
+            ahead,
+            climbers,
         )
         moved = self._sent is None or self._sent.distance_to(leg) > config.follow_threshold_m
         if moved or now - self._sent_at >= config.goto_resend_s:

@@ -200,3 +200,33 @@ def test_a_relief_is_not_sent_over_the_slot_the_uav_it_relieves_is_leaving():
     obstacles, ahead = relief.obstacles(0.0, track), relief.ahead(0.0, track)
     leg = next_leg(hold, SLOT, obstacles, 2.5, layer=(1, 3), traffic=obstacles, ahead=ahead)
     assert leg.z_m >= SLOT.z_m + 2.5
+
+
+def test_a_uav_waits_to_cross_the_column_of_a_later_one_climbing_through_its_height():
+    """Chaos seed 14: uav-1 and uav-3 climbed out of neighbouring spots of
+    C2; uav-1, re-routed at 12.6 m, flew level east across uav-3's column as
+    uav-3 climbed through 12 m (0.88 m). uav-1 ignores uav-3's climb target
+    (seed 12's rule), so it holds where it is until uav-3 is clear above."""
+    here, target = p(-1.0, 20.0, 12.6), p(12.0, 20.0, 12.4)
+
+    def seen_by_uav1(climber_z: float) -> Traffic:
+        climb = TrafficEntry(
+            uav_id="uav-3", position=p(1.0, 20.0, climber_z), airborne=True, target=p(1, 20, 21)
+        )
+        traffic = Traffic("uav-1")
+        traffic.update(TrafficReport(uavs=[climb]), 0.0)
+        return traffic
+
+    def leg(traffic: Traffic) -> Point:
+        obstacles = traffic.obstacles(0.0, (here, target))
+        return next_leg(here, target, obstacles, 2.5, layer=(0, 3), climbers=traffic.climbers(0.0))
+
+    low = seen_by_uav1(11.3)
+    assert next_leg(here, target, low.obstacles(0.0, (here, target)), 2.5, layer=(0, 3)) == target
+    assert leg(low) == here  # holds
+    assert leg(seen_by_uav1(15.5)) == target  # climbed clear: goes
+    uav1_climbing = TrafficEntry(uav_id="uav-1", position=here, airborne=True, target=p(-1, 20, 17))
+    later = Traffic("uav-3")
+    later.update(TrafficReport(uavs=[uav1_climbing]), 0.0)
+    assert later.climbers(0.0) == []  # never waits for one before it (it crosses over its climb)
+    assert p(-1, 20, 17) in later.obstacles(0.0)
