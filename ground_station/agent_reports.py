@@ -159,9 +159,9 @@ class AgentReports:
                 detail=f"stale outcome {outcome.task_id} {outcome.result}",
             )
             return
-        judged = isinstance(task, DeliverTask) and outcome.result == OutcomeResult.COMPLETED
-        if judged:
-            outcome = self._confirm_drop(outcome, task)
+        judged = False
+        if isinstance(task, DeliverTask) and outcome.result == OutcomeResult.COMPLETED:
+            outcome, judged = self._confirm_drop(outcome, task), True
         if task.action_id is not None:
             record = self.book.store.action(task.action_id)
             if record is not None and record.state not in TERMINAL:
@@ -340,12 +340,9 @@ class AgentReports:
         record = self.book.store.action(task.action_id)
         if record is None or record.state in TERMINAL:
             return
-        running = []
-        for uav in self.scenario.fleet.uavs:
-            other = self.monitor.status(uav.id)
-            flown = self._monitoring(other) if other is not None else None
-            if flown is not None and flown.action_id == task.action_id:
-                running.append((flown, other.progress))
+        statuses = [self.monitor.status(uav.id) for uav in self.scenario.fleet.uavs]
+        flying = [(self._monitoring(s), s.progress) for s in statuses if s is not None]
+        running = [(t, p) for t, p in flying if t is not None and t.action_id == task.action_id]
         live = progress.live_monitor_progress(record, running)
         if record.state != ActionState.IN_PROGRESS:
             self.book.transition(record, ActionEvent.STARTED, f"{task.task_id} on station")

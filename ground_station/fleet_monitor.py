@@ -241,8 +241,14 @@ class FleetMonitor:
         """Every UAV's state for a :class:`proto.rpc.FleetReply`; a silent
         one's tasks in ``plans`` (each UAV's current plan) are unknown."""
         out = []
+        checked_s = self._checked_s
         for uav_id, uav in self._uavs.items():
-            silent = uav.silent_since is not None and self._checked_s is not None
+            silence = (
+                self.silence_s(uav_id, checked_s)
+                if uav.silent_since is not None and checked_s is not None
+                else None
+            )
+            silent = silence is not None
             plan = plans.get(uav_id)
             out.append(
                 UavState(
@@ -250,7 +256,7 @@ class FleetMonitor:
                     state=self.state(uav_id),
                     telemetry=uav.telemetry,
                     status=uav.status,
-                    silent_s=round(self.silence_s(uav_id, self._checked_s), 1) if silent else None,
+                    silent_s=round(silence, 1) if silence is not None else None,
                     silent_since_s=uav.silent_since if silent else None,
                     unknown_tasks=unknown_tasks(plan, uav.status) if silent and plan else [],
                 )

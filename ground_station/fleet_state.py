@@ -7,7 +7,7 @@ from __future__ import annotations
 import math
 
 from ground_station.fleet_monitor import FleetMonitor
-from ground_station.planning import UavNow
+from ground_station.planning import UavNow, capacity_wh, home_station
 from proto.plan import DeliverTask, GoHomeTask, MonitorTask, Plan, Task
 from proto.scenario import Scenario
 from proto.site import ChargingStation
@@ -35,10 +35,9 @@ def uavs_now(
     uavs = []
     for spec in fleet.uavs:
         telemetry = monitor.telemetry(spec.id)
-        home = site.station(spec.home_station)
-        capacity = fleet.type_of(spec.id).battery_wh
+        capacity = capacity_wh(fleet, spec.id)
         docked = docks.under(telemetry)
-        where = telemetry.position if telemetry else home.position
+        where = telemetry.position if telemetry else home_station(site, spec).position
         uavs.append(
             UavNow(
                 uav_id=spec.id,

@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import logging
 from collections.abc import Callable
+from typing import TypedDict
 
 import msgspec
 
@@ -57,6 +58,14 @@ log = logging.getLogger(__name__)
 
 RETRY_UNPLACED_S = 30.0
 """Mission seconds between retries of actions that no UAV could take yet."""
+
+
+class PlanQuality(TypedDict):
+    """The live plan's quality, the fields of a ``PlansReply`` beside the plans."""
+
+    objective_s: float | None
+    improved_ago_s: float | None
+    gap_to_best: float | None
 
 
 class MissionManager:
@@ -144,7 +153,7 @@ class MissionManager:
         self.request_replan(f"operator: {request.command} {request.uav_id or 'all'}", stale=True)
         return self.fleet()
 
-    def plan_quality(self) -> dict[str, float | None]:
+    def plan_quality(self) -> PlanQuality:
         """The live plan's objective (seconds: weight-averaged completion +
         makespan), how long ago an improvement was adopted, and its gap to
         the best plan seen for the same state."""
@@ -153,7 +162,7 @@ class MissionManager:
         best = rp.best_objective[1] if rp.best_objective else None
         gap = (objective - best) / best if objective is not None and best else None
         ago = self.clock() - rp.improved_s if rp.improved_s is not None else None
-        return {"objective_s": objective, "improved_ago_s": ago, "gap_to_best": gap}
+        return PlanQuality(objective_s=objective, improved_ago_s=ago, gap_to_best=gap)
 
     def submit(self, request: SubmitAction) -> ActionRecord:
         """Accept an action: validated, stored durably, then planned (later)."""

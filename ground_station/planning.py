@@ -1,6 +1,8 @@
 """The boundary between the mission manager and the pure planner library:
 wire-side state in, a planner ``Problem`` out; a planner ``Plan`` in,
-per-UAV wire ``Task`` lists out.
+per-UAV wire ``Task`` lists out (the steps become tasks in
+:mod:`ground_station.wire_tasks`; reliefs, take-off leads and the
+comparison of task lists are here).
 
 Planner time is relative: the problem's ``now_s`` is 0 and a step's times
 are seconds from now; wire tasks carry absolute mission seconds.
@@ -14,26 +16,15 @@ from __future__ import annotations
 import dataclasses
 import itertools
 from collections.abc import Iterable
+from typing import TypedDict
 
 import msgspec
 
 from ground_station import planner as pl
-from ground_station.monitor_bearings import task_bearing
-from proto.fleet import Fleet
+from proto.fleet import Fleet, UavSpec
 from proto.geo import Point
 from proto.mission import ActionRecord, DeliverAction, InspectAction, MonitorAction
-from proto.plan import (
-    DeliverTask,
-    GoHomeTask,
-    InspectTask,
-    MonitorTask,
-    PickTask,
-    Plan,
-    RechargeTask,
-    Task,
-    WaitTask,
-    Waypoint,
-)
+from proto.plan import MonitorTask, Plan, Task, WaitTask
 from proto.site import BatterySwap, ChargingStation, Safety, Site
 
 
@@ -72,6 +63,24 @@ DROP_HEIGHT_M = 2.0
 
 def _xyz(p: Point, above_m: float = 0.0) -> tuple[float, float, float]:
     return (p.x_m, p.y_m, p.z_m + above_m)
+
+
+def capacity_wh(fleet: Fleet, uav_id: str) -> float:
+    """The battery capacity of ``uav_id`` (a loaded scenario's fleet gives
+    each of its UAVs a type it has)."""
+    uav_type = fleet.type_of(uav_id)
+    if uav_type is None:
+        raise KeyError(f"UAV {uav_id!r} has no type in the fleet")
+    return uav_type.battery_wh
+
+
+def home_station(site: Site, spec: UavSpec) -> ChargingStation:
+    """The home station of ``spec`` (a loaded scenario's fleet names
+    stations of its site)."""
+    station = site.station(spec.home_station)
+    if station is None:
+        raise KeyError(f"UAV {spec.id!r}: no charging station {spec.home_station!r}")
+    return station
 
 
 def flown_s(segment: MonitorTask, at_s: float) -> float:
@@ -162,6 +171,14 @@ def build_problem(
     )
 
 
+class _ActionCommon(TypedDict):
+    """The fields every planner action has."""
+
+    id: str
+    weight: float
+    release_s: float
+
+
 def _action(
     record: ActionRecord,
     workers: dict[str, Point],
@@ -177,11 +194,11 @@ def _action(
     now: what is left starts at once (the UAVs on station keep it, unless
     they cannot), never after a gap for a UAV the planner likes better."""
     action = record.action
-    common = {
-        "id": record.action_id,
-        "weight": action.priority,
-        "release_s": max(0.0, action.release_s - now_s) if action.release_s else 0.0,
-    }
+    common = _ActionCommon(
+        id=record.action_id,
+        weight=action.priority,
+        release_s=max(0.0, action.release_s - now_s) if action.release_s else 0.0,
+    )
     match action:
         case InspectAction(waypoints=waypoints):
             return pl.InspectAction(
@@ -232,73 +249,6 @@ def monitor_starts(plans: Iterable[Plan]) -> dict[str, float]:
                 begin = task.window_start_s
                 starts[task.action_id] = min(begin, starts.get(task.action_id, begin))
     return starts
-
-
-def to_tasks(
-    uav_plan: pl.UavPlan,
-    site: Site,
-    fleet: Fleet,
-    records: dict[str, ActionRecord],
-    now_s: float,
-    flying: dict[str, MonitorTask] | None = None,
-) -> list[Task]:
-    """One UAV's planner steps as wire tasks (absolute mission seconds). A
-    segment that goes on one of ``flying`` (by task id) keeps its window's
-    start: its duration counts what was flown before ``now_s`` too, so the
-    agent ends it, and the ground station credits it, as one segment."""
-    capacity = fleet.type_of(uav_plan.uav_id).battery_wh
-    stations = {s.id: s for s in site.stations}
-    tasks: list[Task] = []
-    counts: dict[str, int] = {}
-    steps = list(uav_plan.steps)
-    i = 0
-    while i < len(steps):
-        step = steps[i]
-        times = {
-            "start_s": now_s + step.start_s,
-            "end_s": now_s + step.end_s,
-            "energy_after_wh": step.energy_after_wh,
-        }
-        record = records.get(step.action_id) if step.action_id else None
-        action = record.action if record else None
-        if step.kind == "inspect" and isinstance(action, InspectAction):
-            j = i
-            while (
-                j + 1 < len(steps)
-                and steps[j + 1].kind == "inspect"
-                and steps[j + 1].action_id == step.action_id
-            ):
-                j += 1
-            group = steps[i : j + 1]
-            times["end_s"] = now_s + group[-1].end_s
-            times["energy_after_wh"] = group[-1].energy_after_wh
-            tasks.append(
-                InspectTask(
-                    task_id=f"{step.action_id}.wp{group[0].index}-{group[-1].index}",
-                    action_id=step.action_id,
-                    waypoints=[
-                        Waypoint(
-                            index=s.index,
-                            position=action.waypoints[s.index].position,
-                            service_s=action.waypoints[s.index].service_s,
-                        )
-                        for s in group
-                    ],
-                    **times,
-                )
-            )
-            i = j + 1
-            continue
-        task = _simple_task(
-            step, record, uav_plan.uav_id, stations, site.safety, capacity, counts, times
-        )
-        going_on = (flying or {}).get(task.task_id)
-        if isinstance(task, MonitorTask) and going_on is not None:
-            duration = task.duration_s + flown_s(going_on, now_s)
-            task = msgspec.structs.replace(task, duration_s=duration)
-        tasks.append(task)
-        i += 1
-    return lead_departures(tasks)
 
 
 def name_reliefs(tasks: dict[str, list[Task]]) -> dict[str, list[Task]]:
@@ -355,84 +305,6 @@ def lead_departures(tasks: list[Task]) -> list[Task]:
                 continue
         out.append(task)
     return out
-
-
-def _simple_task(
-    step: pl.Step,
-    record: ActionRecord | None,
-    uav_id: str,
-    stations: dict[str, ChargingStation],
-    safety: Safety,
-    capacity: float,
-    counts: dict[str, int],
-    times: dict[str, float],
-) -> Task:
-    """A wire task for a planner step other than inspect."""
-    action = record.action if record is not None else None
-
-    def ordinal(kind: str) -> int:
-        counts[kind] = counts.get(kind, 0) + 1
-        return counts[kind]
-
-    match step.kind:
-        case "monitor":
-            done = record.segments.get(uav_id, 0) if record is not None else 0
-            return MonitorTask(
-                task_id=f"{step.action_id}.slot{step.index}.{uav_id}."
-                f"{done + ordinal('monitor:' + step.action_id)}",
-                action_id=step.action_id,
-                worker_id=action.worker_id,
-                slot=step.index,
-                slots=action.uavs,
-                standoff_m=action.standoff_m,
-                height_m=safety.monitor_height_m,
-                bearing_deg=task_bearing(record, step.index),
-                duration_s=max(0.001, step.end_s - step.arrive_s),
-                **times,
-            )
-        case "pick":
-            return PickTask(
-                task_id=f"{step.action_id}.pick",
-                action_id=step.action_id,
-                tool=action.tool,
-                tool_station_id=action.tool_station_id,
-                position=_point(step.position_m),
-                pick_s=action.pick_s,
-                **times,
-            )
-        case "deliver":
-            return DeliverTask(
-                task_id=f"{step.action_id}.drop",
-                action_id=step.action_id,
-                tool=action.tool,
-                worker_id=action.worker_id,
-                drop_s=action.drop_s,
-                **times,
-            )
-        case "recharge":
-            return RechargeTask(
-                task_id=f"{uav_id}.recharge{ordinal('recharge')}",
-                station_id=step.station,
-                position=stations[step.station].position,
-                until_fraction=min(1.0, step.energy_after_wh / capacity),
-                **times,
-            )
-        case "wait":
-            return WaitTask(
-                task_id=f"{uav_id}.wait{ordinal('wait')}", until_s=times["end_s"], **times
-            )
-        case "home":
-            return GoHomeTask(
-                task_id=f"{uav_id}.home",
-                station_id=step.station,
-                position=stations[step.station].position,
-                **times,
-            )
-    raise ValueError(f"planner step {step.kind!r} has no wire task")
-
-
-def _point(xyz: tuple[float, float, float]) -> Point:
-    return Point(x_m=xyz[0], y_m=xyz[1], z_m=xyz[2])
 
 
 SAME_WAIT_S = 1.0

@@ -31,13 +31,14 @@ from ground_station.live_plan import (
 from ground_station.operator_control import OperatorControl
 from ground_station.planning import (
     build_problem,
+    capacity_wh,
     monitor_starts,
     name_reliefs,
     same_work,
-    to_tasks,
 )
 from ground_station.replan_jobs import Computed, ImproveSettings, Job, ReplanOutcome, ReplanStats
 from ground_station.store import Store, StoreUnavailable
+from ground_station.wire_tasks import to_tasks
 from proto.events import EventKind
 from proto.mission import ActionRecord
 from proto.plan import Plan
@@ -171,7 +172,7 @@ class Replanner:
     def compute(self, job: Job) -> Computed:
         """Plan ``job`` on the live session (pure: any thread, one at a time)."""
         site, fleet = self.scenario.site, self.scenario.fleet
-        capacities = {u.id: fleet.type_of(u.id).battery_wh for u in fleet.uavs}
+        capacities = {u.id: capacity_wh(fleet, u.id) for u in fleet.uavs}
 
         def build(base_s: float) -> pl.Problem:
             return build_problem(

@@ -266,15 +266,15 @@ class GroundStation:
             "store_failing": float(self.store.failing is not None),
             "events_unstored": self.events.unstored,
         }
-        quality = {
-            "plan_objective_s": "objective_s",
-            "plan_improved_ago_s": "improved_ago_s",
-            "plan_gap_to_best": "gap_to_best",
-        }
         plan_quality = self.manager.plan_quality()
-        for name, key in quality.items():
-            if plan_quality[key] is not None:
-                values[name] = float(plan_quality[key])
+        quality = {
+            "plan_objective_s": plan_quality["objective_s"],
+            "plan_improved_ago_s": plan_quality["improved_ago_s"],
+            "plan_gap_to_best": plan_quality["gap_to_best"],
+        }
+        for name, value in quality.items():
+            if value is not None:
+                values[name] = float(value)
         for state, count in self.store.action_counts().items():
             values[f"actions_{state}"] = count
         return values

@@ -17,7 +17,7 @@ import msgspec
 from proto.errors import InvalidAction
 from proto.fleet import Capability, Fleet
 from proto.mission import Action, DeliverAction, InspectAction, MonitorAction
-from proto.site import Site
+from proto.site import BatterySwap, Site
 
 MAX_RANGE_M = 100_000.0  # farther than any site: a typo, not a mission
 MAX_ALTITUDE_M = 1_000.0
@@ -127,7 +127,7 @@ def coverable_s(site: Site, fleet: Fleet, k: int) -> float:
     """
     recharge_s = (
         min(
-            (getattr(s.recharge, "swap_s", None) or getattr(s.recharge, "full_charge_s", 0.0))
+            s.recharge.swap_s if isinstance(s.recharge, BatterySwap) else s.recharge.full_charge_s
             for s in site.stations
         )
         if site.stations

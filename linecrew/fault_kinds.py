@@ -4,6 +4,7 @@
 from __future__ import annotations
 
 import argparse
+from collections.abc import Callable
 
 import msgspec
 
@@ -21,7 +22,7 @@ from proto.sim import (
 )
 
 # kind -> (help, positional arguments after the target, builder)
-FAULT_KINDS = {
+FAULT_KINDS: dict[str, tuple[str, list[str], Callable[[str, list[str]], SimFault]]] = {
     "battery": (
         "set the battery to FRACTION (0..1)",
         ["fraction"],

@@ -17,7 +17,7 @@ import dataclasses
 import os
 import typing
 from collections.abc import Mapping
-from typing import ClassVar, Self
+from typing import Any, ClassVar, Self
 
 import msgspec
 
@@ -31,6 +31,7 @@ class EnvSettings:
     """Mixin of a frozen settings dataclass: ``from_env`` and ``check``."""
 
     ENV_PREFIX: ClassVar[str]
+    __dataclass_fields__: ClassVar[dict[str, dataclasses.Field[Any]]]  # set by @dataclass
 
     @classmethod
     def from_env(cls, env: Mapping[str, str] | None = None, **overrides: object) -> Self:

@@ -109,7 +109,7 @@ class Comms:
         """Ask the ground station for our current plan."""
         request = GetPlans(uav_id=self.uav_id)
         try:
-            reply = await self.bus.query_async(
+            reply: PlansReply = await self.bus.query_async(
                 self.keys.plan(self.uav_id), request, PlansReply, self.config.plan_query_timeout_s
             )
         except LinecrewError as exc:

@@ -6,12 +6,15 @@ nothing else, whatever the bytes.
 from __future__ import annotations
 
 import threading
-from typing import Any, TypeVar
+from typing import TYPE_CHECKING, Any, TypeVar
 
 import msgspec
 
 from proto.base import MIN_SCHEMA_VERSION, SCHEMA_VERSION
 from proto.errors import DecodeError, EncodeError
+
+if TYPE_CHECKING:
+    from typing_extensions import TypeForm  # a message class or a union of them
 
 MAX_MESSAGE_BYTES = 1 << 20
 """Largest payload accepted or produced (1 MiB)."""
@@ -62,7 +65,7 @@ def encode(message: msgspec.Struct) -> bytes:
     return data
 
 
-def decode(data: bytes | bytearray | memoryview, message_type: type[T] | Any) -> T:
+def decode(data: bytes | bytearray | memoryview, message_type: TypeForm[T]) -> T:
     """Decode ``data`` as ``message_type`` (a message class or a union of them).
 
     Raises :class:`DecodeError` for oversized, malformed, truncated or

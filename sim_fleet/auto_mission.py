@@ -51,7 +51,7 @@ NAV_WAYPOINT = Cmd.NAV_WAYPOINT
 NAV_COMMANDS = frozenset(c for c in Cmd if c.name.startswith("NAV_"))
 COMMANDS = frozenset(Cmd)
 # AP_Mission::Mission_Command::type()
-NAMES = {
+NAMES: dict[int, str] = {
     Cmd.NAV_WAYPOINT: "WP",
     Cmd.NAV_LOITER_TIME: "LoitTime",
     Cmd.NAV_RETURN_TO_LAUNCH: "RTL",

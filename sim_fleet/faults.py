@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import logging
+from collections.abc import Iterable
 
 from proto.errors import InvalidRequest, NotFound
 from proto.sim import (
@@ -79,5 +80,5 @@ def _applied(world: World, target: str, detail: str) -> FaultApplied:
     return FaultApplied(target=target, detail=detail, sim_time_s=world.time_s)
 
 
-def _unknown(what: str, ident: str, known: object) -> str:
+def _unknown(what: str, ident: str, known: Iterable[str]) -> str:
     return f"no {what} {ident!r} (known: {', '.join(known)})"

@@ -20,6 +20,7 @@ from __future__ import annotations
 import asyncio
 import concurrent.futures
 import contextlib
+import functools
 import logging
 import threading
 import time
@@ -84,15 +85,16 @@ class Fleet:
         try:
             for i, (vid, vehicle) in enumerate(self.world.vehicles.items()):
                 port = cfg.base_port + i if cfg.base_port else 0
-                ep = VehicleEndpoint(
+                endpoint = functools.partial(
+                    VehicleEndpoint,
                     self.world,
                     vehicle,
                     rates=cfg.rates,
                     static_peers=cfg.static_peers,
                     signing_key=cfg.signing_keys.get(vid),
                 )
-                transport, _ = await self._loop.create_datagram_endpoint(
-                    lambda ep=ep: ep, local_addr=(cfg.host, port)
+                transport, ep = await self._loop.create_datagram_endpoint(
+                    endpoint, local_addr=(cfg.host, port)
                 )
                 self._transports.append(transport)
                 self.endpoints[vid] = ep

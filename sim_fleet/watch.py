@@ -11,7 +11,6 @@ flown.
 
 from __future__ import annotations
 
-import collections
 import math
 from collections.abc import Iterable
 
@@ -21,12 +20,20 @@ from sim_fleet.scenario import InteractionRules, Vec3
 from sim_fleet.vehicle import Vehicle
 
 
+class Seconds(dict[tuple[str, str], float]):
+    """Seconds per (worker id, vehicle id); like a ``Counter``, 0.0 for a
+    pair not credited yet, without adding it."""
+
+    def __missing__(self, key: tuple[str, str]) -> float:
+        return 0.0
+
+
 class WatchLog:
     """Watched seconds per (worker id, vehicle id), summed over the run."""
 
     def __init__(self, rules: InteractionRules) -> None:
         self.rules = rules
-        self.seconds: collections.Counter[tuple[str, str]] = collections.Counter()
+        self.seconds = Seconds()
 
     def step(self, vehicles: Iterable[Vehicle], workers: dict[str, Vec3], dt_s: float) -> None:
         """Credit ``dt_s`` to every vehicle watching a worker now."""

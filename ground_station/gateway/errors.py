@@ -4,6 +4,8 @@
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING, TypeVar
+
 import msgspec
 from fastapi import Request
 from fastapi.exceptions import RequestValidationError
@@ -11,6 +13,11 @@ from fastapi.responses import JSONResponse
 from starlette.exceptions import HTTPException
 
 from proto.errors import InvalidRequest, LinecrewError, http_status
+
+if TYPE_CHECKING:
+    from typing_extensions import TypeForm  # a class or a union of them, as msgspec takes
+
+T = TypeVar("T")
 
 
 class ErrorBody(msgspec.Struct, frozen=True, kw_only=True):
@@ -65,7 +72,7 @@ def known_query_only(request: Request) -> None:
         raise InvalidRequest(f"unknown query parameter {name!r}", field=name)
 
 
-def decode_body(body: bytes, body_type: type) -> object:
+def decode_body(body: bytes, body_type: TypeForm[T]) -> T:
     """Decode a JSON body; a bad one is a 422 naming the field."""
     try:
         return msgspec.json.decode(body, type=body_type)

@@ -70,14 +70,13 @@ class Vocabulary:
                     duration_s=template.duration_s,
                 )
         _worker(site, target)
-        station = next(
-            (s for s in site.tool_stations if template.tool in {t.name for t in s.tools}), None
-        )
-        if station is None:
-            raise InvalidAction(f"no tool station holds {template.tool!r}", field="gesture")
+        tool = template.tool
+        station = next((s for s in site.tool_stations if tool in {t.name for t in s.tools}), None)
+        if tool is None or station is None:
+            raise InvalidAction(f"no tool station holds {tool!r}", field="gesture")
         return DeliverAction(
             priority=template.priority,
-            tool=template.tool,
+            tool=tool,
             tool_station_id=station.id,
             worker_id=target,
         )

@@ -24,7 +24,7 @@ from proto.telemetry import HumanPose
 
 log = logging.getLogger("linecrew.gateway")
 
-STREAMS_GRACE_S = 3.0
+STREAMS_GRACE_S = 3
 """On SIGTERM, open requests (an event stream never ends by itself) get this
 long before they are cut and the gateway exits."""
 

@@ -121,7 +121,7 @@ def _cover_needs(
         t, s, end = heapq.heappop(need)
         pos = slots[s]
         pre = _rank_uavs(ctx, fleet, pos, t, push)
-        ranked = []
+        ranked: list[tuple[float, str, float, float, int]] = []
         for base, uid, suit, p in pre:
             if len(ranked) >= MAX_REACH:
                 break
@@ -171,10 +171,10 @@ def repair(ctx: Ctx, a: MonitorAction, gaps: list[tuple[float, int, float]]) -> 
     return False
 
 
-def _keep_start(ctx: Ctx, a: MonitorAction, uids: list[str]) -> bool:
-    """Commit a coverage from the promised ``a.start_s``; False (unchanged) if infeasible."""
+def _keep_start(ctx: Ctx, a: MonitorAction, start_s: float, uids: list[str]) -> bool:
+    """Commit a coverage from the promised ``start_s``; False (unchanged) if infeasible."""
     snap = ctx.snapshot()
-    if _cover(ctx, a, a.start_s, uids) is not None:
+    if _cover(ctx, a, start_s, uids) is not None:
         return True
     ctx.restore(snap)
     return False
@@ -228,7 +228,7 @@ def place_monitor(ctx: Ctx, a: MonitorAction) -> None:
     t0 = ready.nth(a.k - 1)
     promised = a.start_s if a.start_s is not None and a.start_s >= base else None
     keep = promised is not None and (t0 is None or t0 > promised - EARLIER_S)
-    if keep and _keep_start(ctx, a, uids):
+    if keep and promised is not None and _keep_start(ctx, a, promised, uids):
         return
     if t0 is None:
         ctx.add_unplaced(a.id, None, "monitor_coverage_infeasible")
@@ -251,7 +251,7 @@ def place_monitor(ctx: Ctx, a: MonitorAction) -> None:
         if best is not None:
             break
     retry = promised is not None and not keep and (best is None or best[1] > promised)
-    if retry and _keep_start(ctx, a, uids):
+    if retry and promised is not None and _keep_start(ctx, a, promised, uids):
         return  # the earlier start did not work out: the promise stands (not tried yet)
     if best is None:
         ctx.add_unplaced(a.id, None, "monitor_coverage_infeasible")

@@ -134,7 +134,7 @@ class Session:
             if not self._pending:
                 return
             pending, self._pending = list(dict.fromkeys(self._pending)), []
-            whole = []
+            whole: list[Action] = []
             for aid in pending:
                 a = ctx.actions.get(aid)
                 if a is None:
@@ -253,7 +253,7 @@ class Session:
             sim = simulate(r.kin, ctx.site, ctx.pads, init, tasks, (uid, -1e18))
             if not isinstance(sim, str):
                 break
-            j = max(0, getattr(sim, "index", 0))
+            j = max(0, sim.task_index)
             bad = {tasks[j].action_id} if attempt < 10 else {t.action_id for t in tasks[j:]}
             for t in tasks:
                 if t.action_id in bad:

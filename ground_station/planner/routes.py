@@ -187,15 +187,16 @@ class Ctx:
         for _ in range(3):
             # Repair: a later task may need the recharge the removed work used
             # to trigger; ask for a top-up just before the failing task.
-            if not isinstance(sim, str) or sim.index < 0:
+            if not isinstance(sim, str) or sim.task_index < 0:
                 break
-            j = sim.index if keep[sim.index].anchor_s is None else max(0, sim.index - 1)
+            failed = sim.task_index
+            j = failed if keep[failed].anchor_s is None else max(0, failed - 1)
             if keep[j].topup:
                 break
             keep = [*keep[:j], keep[j].copy_topup(), *keep[j + 1 :]]
             sim = simulate(r.kin, self.site, self.pads, st, keep, ign, r.states, old_map)
         if isinstance(sim, str):
-            self.last_fail = keep[sim.index] if getattr(sim, "index", -1) >= 0 else None
+            self.last_fail = keep[sim.task_index] if sim.task_index >= 0 else None
             return None
         self._replace_suffix(uid, first, keep, sim)
         return removed

@@ -138,8 +138,8 @@ def advance(
             if anchor is not None or depth >= MAX_HOPS:
                 return "point_busy"
             del steps[n_steps:], res[n_res:]
-            later = task.released(free)
-            return advance(k, site, pads, st0, later, steps, res, ign, depth + 1, soft)
+            deferred = task.released(free)
+            return advance(k, site, pads, st0, deferred, steps, res, ign, depth + 1, soft)
     if wait > EPS_S:
         if not st.landed and not hold_wait(site, pads, pos, t, t + wait, ign, res):
             return "point_busy"
@@ -193,7 +193,7 @@ def simulate(
     ign: Ignore,
     old: list[State] | None = None,
     old_map: list[int] | None = None,
-) -> Sim | str:
+) -> Sim | Fail:
     """Simulate ``tasks`` from ``st``; a reason code (``Fail``) if one is
     infeasible. With ``old``/``old_map`` (task i was task ``old_map[i]`` of
     the route being edited, -1 if new), stops as soon as the state after a
@@ -208,7 +208,7 @@ def simulate(
         nxt = advance(k, site, pads, st, task, steps, res, ign, 0, soft[i])
         if isinstance(nxt, str):
             fail = Fail(nxt)
-            fail.index = i
+            fail.task_index = i
             return fail
         states.append(nxt)
         st = nxt

@@ -78,9 +78,9 @@ class Task:
 
 
 class Fail(str):
-    """A reason code that also says which task (index) failed."""
+    """A reason code that also says which task (``task_index``) failed."""
 
-    index: int = -1
+    task_index: int = -1
 
 
 class State(NamedTuple):

@@ -14,18 +14,26 @@ from math import cos, dist, pi, radians, sin
 
 from ground_station.planner.model import (
     WAIT_ASIDE_M,
+    Action,
     DeliverAction,
     InspectAction,
     MonitorAction,
     Problem,
+    Station,
+    Uav,
+    Vec3,
 )
-from ground_station.planner.result import Plan, Violation
+from ground_station.planner.result import Plan, Step, Violation
 
 TOL_S = 1e-3
 TOL_WH = 1e-3
 TOL_M = 0.01
 STANDOFF_TOL_M = 0.5
 SERVICE_KIND = {"inspect": "inspect", "monitor": "monitor", "pick": "deliver", "deliver": "deliver"}
+Hold = tuple[float, float, Vec3, str]
+"""A hover: from, until, where, which UAV."""
+PadUse = dict[str, list[tuple[float, float]]]
+"""Station id -> the (from, until) intervals a pad there is taken."""
 KIND_OF = {InspectAction: "inspect", MonitorAction: "monitor", DeliverAction: "deliver"}
 
 
@@ -49,11 +57,11 @@ def validate(problem: Problem, plan: Plan) -> list[Violation]:
     actions = {a.id: a for a in problem.actions}
     reserve = problem.reserve_fraction
     seen: set[str] = set()
-    pad_use: dict[str, list[tuple[float, float]]] = defaultdict(list)
+    pad_use: PadUse = defaultdict(list)
     monitor_iv: dict[str, list[tuple[int, float, float]]] = defaultdict(list)
     waypoints: dict[str, list[int]] = defaultdict(list)
     delivered: dict[str, int] = defaultdict(int)
-    holds: list[tuple[float, float, tuple[float, float, float], str]] = []
+    holds: list[Hold] = []
     for up in plan.uavs:
         uid = up.uav_id
         u = uavs.get(uid)
@@ -154,8 +162,11 @@ def validate(problem: Problem, plan: Plan) -> list[Violation]:
                     need = None
                     if isinstance(act, InspectAction) and 0 <= s.index < len(act.waypoints):
                         need = act.waypoints[s.index].service_s
-                        same = run is not None and (run.action_id, run.index) == (act.id, s.index)
-                        if same and fresh:  # continuing the running task
+                        if (
+                            fresh
+                            and run is not None
+                            and (run.action_id, run.index) == (act.id, s.index)
+                        ):  # continuing the running task
                             need = min(need, run.remaining_s)
                     if need is not None and serve < need - TOL_S:
                         rep.add("service_too_short", f"{where}: {serve:.2f} s < {need} s", uid)
@@ -207,7 +218,16 @@ def validate(problem: Problem, plan: Plan) -> list[Violation]:
     return rep.items
 
 
-def _check_action_step(rep, problem, uid, caps, s, act, where, drop_s=None) -> None:  # type: ignore[no-untyped-def]
+def _check_action_step(
+    rep: _Report,
+    problem: Problem,
+    uid: str,
+    caps: dict[str, float],
+    s: Step,
+    act: Action | None,
+    where: str,
+    drop_s: float | None = None,
+) -> None:
     kind = SERVICE_KIND[s.kind]
     if kind not in caps:
         rep.add("capability", f"{where}: UAV type cannot {kind}", uid, s.action_id)
@@ -253,7 +273,9 @@ def _slot(act: MonitorAction, slot: int, aside_m: float = 0.0) -> tuple[float, f
     )
 
 
-def _hold_point(s, before, actions, at_station, landed):  # type: ignore[no-untyped-def]
+def _hold_point(
+    s: Step, before: Step | None, actions: dict[str, Action], at_station: bool, landed: bool
+) -> Vec3 | None:
     """Where step ``s`` hovers (None if it does not): its position for work,
     an airborne wait's too, or aside of the slot it follows (``WAIT_ASIDE_M``)."""
     if s.kind in SERVICE_KIND:
@@ -261,15 +283,15 @@ def _hold_point(s, before, actions, at_station, landed):  # type: ignore[no-unty
     if s.kind != "wait" or at_station or landed:
         return None
     if before is not None and before.kind == "monitor" and before.index is not None:
-        act = actions.get(before.action_id)
+        act = actions.get(before.action_id) if before.action_id is not None else None
         if isinstance(act, MonitorAction):
             return _slot(act, before.index, WAIT_ASIDE_M)
     return s.position_m
 
 
-def _check_separation(rep: _Report, separation_m: float, holds) -> None:  # type: ignore[no-untyped-def]
+def _check_separation(rep: _Report, separation_m: float, holds: list[Hold]) -> None:
     """No two UAVs hover nearer than ``separation_m`` at once."""
-    active: list[tuple[float, float, tuple[float, float, float], str]] = []
+    active: list[Hold] = []
     for hold in sorted(holds):
         start, end, where, uid = hold
         active = [a for a in active if a[1] > start + TOL_S]
@@ -284,7 +306,14 @@ def _check_separation(rep: _Report, separation_m: float, holds) -> None:  # type
         active.append(hold)
 
 
-def _check_end(rep: _Report, problem: Problem, u, steps, stations, pad_use) -> None:  # type: ignore[no-untyped-def]
+def _check_end(
+    rep: _Report,
+    problem: Problem,
+    u: Uav,
+    steps: tuple[Step, ...],
+    stations: dict[str, Station],
+    pad_use: PadUse,
+) -> None:
     """``problem.end``: the UAV ends landed at home, or (``any_station``) at
     a station, where away from home it holds a pad from its landing on."""
     last = steps[-1] if steps else None
@@ -301,7 +330,7 @@ def _check_end(rep: _Report, problem: Problem, u, steps, stations, pad_use) -> N
         pad_use[at[0].id].append((last.end_s if last else problem.now_s, float("inf")))
 
 
-def _check_pads(rep: _Report, stations, pad_use) -> None:  # type: ignore[no-untyped-def]
+def _check_pads(rep: _Report, stations: dict[str, Station], pad_use: PadUse) -> None:
     for sid, ivs in pad_use.items():
         events = sorted([(a + TOL_S, 1) for a, _ in ivs] + [(b, -1) for _, b in ivs])
         level = 0
@@ -312,7 +341,14 @@ def _check_pads(rep: _Report, stations, pad_use) -> None:  # type: ignore[no-unt
                 break
 
 
-def _check_actions(rep, problem, plan, monitor_iv, waypoints, delivered) -> None:  # type: ignore[no-untyped-def]
+def _check_actions(
+    rep: _Report,
+    problem: Problem,
+    plan: Plan,
+    monitor_iv: dict[str, list[tuple[int, float, float]]],
+    waypoints: dict[str, list[int]],
+    delivered: dict[str, int],
+) -> None:
     unplaced: dict[str, set] = defaultdict(set)
     for x in plan.unplaced:
         unplaced[x.action_id].add(x.part)

@@ -125,7 +125,7 @@ class Store:
             "SELECT plan FROM plans p WHERE epoch = "
             "(SELECT MAX(epoch) FROM plans q WHERE q.uav_id = p.uav_id)"
         ).fetchall()
-        plans = [codec.decode(row[0], Plan) for row in rows]
+        plans: list[Plan] = [codec.decode(row[0], Plan) for row in rows]
         return {plan.uav_id: plan for plan in plans}
 
     def plan_at(self, uav_id: str, epoch: int) -> Plan | None:

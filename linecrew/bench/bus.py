@@ -19,6 +19,7 @@ import sys
 import threading
 import time
 
+from linecrew.bench.child import wait_ready
 from linecrew.bus.config import BusConfig
 from linecrew.bus.router_process import router_process
 from linecrew.bus.session import Bus
@@ -35,6 +36,8 @@ from proto import (
 )
 
 KEYS = KeySpace("bench")
+Metrics = dict[str, float | None]
+"""Metric name -> value (None: nothing measured)."""
 
 
 def _telemetry(stamp: float) -> Telemetry:
@@ -49,7 +52,7 @@ def _telemetry(stamp: float) -> Telemetry:
     )
 
 
-def _latency(pub: Bus, sub: Bus, count: int, period_s: float) -> dict[str, float]:
+def _latency(pub: Bus, sub: Bus, count: int, period_s: float) -> Metrics:
     """Send ``count`` messages every ``period_s`` (0: flat out); receive latencies."""
     key = KEYS.telemetry("uav-1")
     latencies: list[float] = []
@@ -82,7 +85,7 @@ def _warm_up(pub: Bus, key: str, received: list[float]) -> None:
         time.sleep(0.02)
 
 
-def _query_rtt(server: Bus, client: Bus, count: int) -> dict[str, float]:
+def _query_rtt(server: Bus, client: Bus, count: int) -> Metrics:
     loop = asyncio.new_event_loop()
     ready = threading.Event()
     stop = asyncio.Event()
@@ -140,7 +143,7 @@ def _vanish_time(watcher: Bus, endpoint: str, lease_ms: int, sig: signal.Signals
     ):
         child = subprocess.Popen([sys.executable, "-c", code], stdout=subprocess.PIPE)
         try:
-            child.stdout.readline()
+            wait_ready(child)
             deadline = time.monotonic() + 10
             while True not in events and time.monotonic() < deadline:
                 time.sleep(0.005)
@@ -154,7 +157,7 @@ def _vanish_time(watcher: Bus, endpoint: str, lease_ms: int, sig: signal.Signals
     return (events.get(False, float("nan")) - killed) * 1e3
 
 
-def run(samples: int, lease_ms: int, repeats: int) -> dict[str, dict[str, float]]:
+def run(samples: int, lease_ms: int, repeats: int) -> dict[str, Metrics]:
     """Run every measurement; returns name -> metrics."""
     with router_process("bench", lease_ms) as endpoint:
         config = BusConfig(connect=(endpoint,), lease_ms=lease_ms)
@@ -174,7 +177,7 @@ def run(samples: int, lease_ms: int, repeats: int) -> dict[str, dict[str, float]
     return results
 
 
-def _print_table(results: dict[str, dict[str, float]]) -> None:
+def _print_table(results: dict[str, Metrics]) -> None:
     from rich.console import Console
     from rich.table import Table
 

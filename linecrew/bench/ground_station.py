@@ -33,6 +33,7 @@ from collections.abc import Callable
 
 import msgspec
 
+from linecrew.bench.child import wait_ready
 from linecrew.bench.light_agent import LightAgent
 from linecrew.bus import Bus, BusConfig
 from linecrew.bus.router_process import router_process
@@ -150,10 +151,12 @@ def _event_to_plan(
         if replan is None:
             continue
         epoch = replan[1].epoch
+        if epoch is None:
+            raise ValueError(f"replan event without an epoch: {replan[1]}")
         changed = [
             e.uav_id
             for _, e in watch.items
-            if e.kind == EventKind.PLAN_CHANGED and e.epoch == epoch
+            if e.kind == EventKind.PLAN_CHANGED and e.epoch == epoch and e.uav_id is not None
         ]
         deadline = time.monotonic() + 10
         arrivals = []
@@ -172,7 +175,7 @@ def _event_to_plan(
     return latencies
 
 
-def _improvements(watch: _EventWatch, since: float) -> set[int]:
+def _improvements(watch: _EventWatch, since: float) -> set[int | None]:
     """Epochs of the improvements adopted since ``since``."""
     return {
         e.epoch
@@ -254,7 +257,7 @@ def _silence_to_lost(
     )
     child = subprocess.Popen([sys.executable, "-c", code], stdout=subprocess.PIPE)
     try:
-        child.stdout.readline()
+        wait_ready(child)
         back = watch.wait_for(lambda e: e.kind == EventKind.UAV_BACK and e.uav_id == uav_id, 20)
         if back is None:
             raise RuntimeError(f"{uav_id} never came up")

@@ -8,6 +8,7 @@ from __future__ import annotations
 import threading
 import time
 
+from ground_station.planning import capacity_wh, home_station
 from linecrew.bus import Bus, BusConfig
 from proto import FlightState, GeoPoint, KeySpace, Plan, Role, Scenario, Telemetry
 
@@ -19,8 +20,8 @@ class LightAgent:
         self.uav_id = uav_id
         self.keys = KeySpace(scenario.site.id)
         spec = next(u for u in scenario.fleet.uavs if u.id == uav_id)
-        self.capacity = scenario.fleet.type_of(uav_id).battery_wh
-        self.position = scenario.site.station(spec.home_station).position
+        self.capacity = capacity_wh(scenario.fleet, uav_id)
+        self.position = home_station(scenario.site, spec).position
         self.plans: list[Plan] = []
         self.arrivals: list[float] = []  # time.perf_counter() at each plan's arrival
         self.bus = Bus.open(config)

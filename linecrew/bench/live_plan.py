@@ -26,7 +26,7 @@ from ground_station.event_log import EventLog
 from ground_station.fleet_monitor import FleetMonitor
 from ground_station.missions import MissionManager
 from ground_station.planner.api import score
-from ground_station.planning import build_problem
+from ground_station.planning import build_problem, capacity_wh, home_station
 from ground_station.replan_jobs import ImproveSettings
 from ground_station.replanner import Replanner
 from ground_station.store import Store
@@ -41,11 +41,11 @@ NOW_S = 100.0
 
 def _telemetry(scenario: Scenario, uav_id: str) -> Telemetry:
     spec = next(u for u in scenario.fleet.uavs if u.id == uav_id)
-    capacity = scenario.fleet.type_of(uav_id).battery_wh
+    capacity = capacity_wh(scenario.fleet, uav_id)
     return Telemetry(
         uav_id=uav_id,
         stamp_s=NOW_S,
-        position=scenario.site.station(spec.home_station).position,
+        position=home_station(scenario.site, spec).position,
         geo=GeoPoint(),
         battery_wh=capacity,
         battery_fraction=1.0,

@@ -14,7 +14,7 @@ import inspect
 import logging
 import time
 from collections.abc import Awaitable, Callable
-from typing import Any, TypeVar
+from typing import TYPE_CHECKING, Any, TypeVar
 
 import msgspec
 import zenoh
@@ -33,6 +33,9 @@ from proto.errors import (
     Unavailable,
 )
 from proto.rpc import ErrorReply
+
+if TYPE_CHECKING:
+    from typing_extensions import TypeForm  # a message class or a union of them
 
 log = logging.getLogger(__name__)
 
@@ -155,7 +158,7 @@ class Bus:
         self.stats.count_published()
 
     def subscribe(
-        self, key: str, message_type: type[T] | Any, callback: Callable[[str, T], None]
+        self, key: str, message_type: TypeForm[T], callback: Callable[[str, T], None]
     ) -> Declared:
         """Call ``callback(key, message)`` for each decodable sample on ``key``
         (on a Zenoh thread: keep it short). Malformed samples are dropped and
@@ -176,9 +179,7 @@ class Bus:
 
         return self._track(self._session.declare_subscriber(key, on_sample))
 
-    def subscribe_async(
-        self, key: str, message_type: type[T] | Any, maxsize: int = 1000
-    ) -> Declared:
+    def subscribe_async(self, key: str, message_type: TypeForm[T], maxsize: int = 1000) -> Declared:
         """Like :meth:`subscribe`, but items ``(key, message)`` are handed to
         the running asyncio loop: ``async with bus.subscribe_async(k, T) as s:
         async for key, msg in s: ...``. When full, the oldest item is dropped."""
@@ -192,7 +193,7 @@ class Bus:
     # -- queries -----------------------------------------------------------------
 
     def serve(
-        self, key: str, request_type: type[T] | Any, handler: Handler, *, with_key: bool = False
+        self, key: str, request_type: TypeForm[T], handler: Handler, *, with_key: bool = False
     ) -> Declared:
         """Answer queries on ``key`` from the running asyncio loop.
 
@@ -250,7 +251,7 @@ class Bus:
                 log.warning("cannot reply on %s: %s", key, exc)
 
     def query(
-        self, key: str, request: msgspec.Struct, reply_type: type[T] | Any, timeout_s: float = 2.0
+        self, key: str, request: msgspec.Struct, reply_type: TypeForm[T], timeout_s: float = 2.0
     ) -> T:
         """Send ``request`` to the queryable on ``key`` and return its decoded
         reply. Raises :class:`RequestError` for an error reply or an undecodable
@@ -262,11 +263,13 @@ class Bus:
                     return codec.decode(reply.ok.payload.to_bytes(), reply_type)
                 except DecodeError as exc:
                     raise RequestError(f"bad reply from {key}: {exc}", code=exc.code) from exc
+            if reply.err is None:
+                raise RequestError(f"a reply from {key} with neither a value nor an error")
             raise _error_from(key, reply.err.payload.to_bytes())
         raise RequestTimeout(f"no reply on {key} within {timeout_s:g} s (is the server up?)")
 
     async def query_async(
-        self, key: str, request: msgspec.Struct, reply_type: type[T] | Any, timeout_s: float = 2.0
+        self, key: str, request: msgspec.Struct, reply_type: TypeForm[T], timeout_s: float = 2.0
     ) -> T:
         """:meth:`query` without blocking the event loop."""
         return await asyncio.to_thread(self.query, key, request, reply_type, timeout_s)
@@ -278,7 +281,7 @@ class Bus:
         the process dies, or when its link's lease expires."""
         return self._track(self._session.liveliness().declare_token(key))
 
-    def watch_liveliness(self, key: str, callback: Callable[[str, bool], None]) -> Declared:
+    def watch_liveliness(self, key: str, callback: Callable[[str, bool], object]) -> Declared:
         """Call ``callback(token_key, alive)`` for tokens matching ``key``:
         first for those already alive, then on every appearance / loss."""
 

@@ -25,6 +25,7 @@ import logging
 import os
 import signal
 from collections.abc import Mapping
+from typing import cast
 
 from linecrew.chaos.netns_run import NetnsRun
 from linecrew.launch.local_run import LocalRun
@@ -63,7 +64,8 @@ class ProcessFaults:
         count = self._restarts[name] = self._restarts.get(name, 0) + 1
         if old.log_path.exists():
             old.log_path.rename(old.log_path.with_name(f"{name}.{count}.log"))
-        args = [str(a) for a in old.popen.args]  # [prefix..., python, -m, module, *args]
+        # Supervisor.start runs a list: [prefix..., python, -m, module, *args]
+        args = [str(a) for a in cast(list[str], old.popen.args)]
         module = args.index("-m") + 1
         return self.run.supervisor.start(name, args[module], *args[module + 1 :], env=env)
 

@@ -100,7 +100,8 @@ def cancel(injection: Injection, ctx: Context, applied: Noted) -> Heal | None:
 def edit(injection: Injection, ctx: Context, applied: Noted) -> Heal | None:
     """``PATCH`` an accepted chaos action's priority or duration; re-read it
     after ``hold_s``."""
-    action_id, change = injection.target, injection.params["change"]
+    action_id = injection.target
+    change: dict[str, Any] = injection.params["change"]
     ctx.edits.pop(action_id, None)  # an unanswered edit may or may not be applied
     response = _call(ctx, applied, "PATCH", action_id, change)
     if response is None:

@@ -260,8 +260,8 @@ class Checker:
 
     def _check_credit(self, at_s: float, actions: list[dict[str, Any]], truth: SimState) -> None:
         self.checks["overcredited"] += 1
-        recorded: collections.Counter[str] = collections.Counter()
-        slack: collections.Counter[str] = collections.Counter()
+        recorded: collections.defaultdict[str, float] = collections.defaultdict(float)
+        slack: collections.defaultdict[str, float] = collections.defaultdict(float)
         for record in actions:
             action = record.get("action") or {}
             if action.get("type") != "monitor":
@@ -269,7 +269,7 @@ class Checker:
             uavs = action.get("uavs", 1)
             recorded[action["worker_id"]] += record.get("monitored_s", 0.0) * uavs
             slack[action["worker_id"]] += CREDIT_SLACK_S * uavs
-        watched: collections.Counter[str] = collections.Counter()
+        watched: collections.defaultdict[str, float] = collections.defaultdict(float)
         for w in truth.watched:
             watched[w.worker_id] += w.seconds
         for worker, seconds in sorted(recorded.items()):

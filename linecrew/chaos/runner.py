@@ -99,7 +99,7 @@ class ChaosRunner:
         self.applied: list[Applied] = []
         self.rejected: dict[str, str] = {}
         self._unsure: dict[str, dict[str, Any]] = {}  # action id -> body, outcome unknown
-        self._heals: list[tuple[float, int, Callable[[], None]]] = []
+        self._heals: list[tuple[float, int, Callable[[], object]]] = []
         self._context: Context | None = None  # what the appliers of injections.py act on
         self._t0 = 0.0
         self.timeline = Timeline(self._now)
@@ -134,7 +134,7 @@ class ChaosRunner:
     # -- the loop -------------------------------------------------------------------
 
     def _loop(
-        self, run: LocalRun, faults: ProcessFaults, http: httpx.Client
+        self, run: LocalRun | NetnsRun, faults: ProcessFaults, http: httpx.Client
     ) -> tuple[int, list[dict[str, Any]] | None]:
         opts = self.options
         scripted = []
@@ -194,7 +194,11 @@ class ChaosRunner:
     # -- injections --------------------------------------------------------------------
 
     def _apply(
-        self, injection: Injection, run: LocalRun, faults: ProcessFaults, http: httpx.Client
+        self,
+        injection: Injection,
+        run: LocalRun | NetnsRun,
+        faults: ProcessFaults,
+        http: httpx.Client,
     ) -> None:
         applied = Applied(injection, self._now())
         self.applied.append(applied)
@@ -312,7 +316,7 @@ class ChaosRunner:
             return None
         return response.json() if response.status_code == 200 else None
 
-    def _sample(self, run: LocalRun, http: httpx.Client) -> list[dict[str, Any]] | None:
+    def _sample(self, run: LocalRun | NetnsRun, http: httpx.Client) -> list[dict[str, Any]] | None:
         actions = self._get(http, "/v1/actions")
         plans = self._get(http, "/v1/plan")
         fleet = self._get(http, "/v1/fleet")
@@ -325,7 +329,7 @@ class ChaosRunner:
         self.checker.sample(self._now(), actions, plans, fleet, truth)
         return actions
 
-    def _event_counts(self, run: LocalRun) -> dict[str, int]:
+    def _event_counts(self, run: LocalRun | NetnsRun) -> dict[str, int]:
         if run.bus is None:
             return {}
         try:

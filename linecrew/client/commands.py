@@ -97,7 +97,7 @@ POINT = re.compile(r"-?[\d.]+(,-?[\d.]+){2,3}")
 """X,Y,Z[,SERVICE_S] on the command line."""
 
 
-def _point(text: str) -> dict[str, float]:
+def _point(text: str) -> dict[str, object]:
     try:
         x, y, z, *rest = (float(v) for v in text.split(","))
     except ValueError:

@@ -22,7 +22,9 @@ class GatewayError(LinecrewError):
 
     def __init__(self, message: str, status: int | None = None, body: Any = None) -> None:
         super().__init__(message)
-        self.status = status  # the HTTP status, when the gateway answered
+        # The gateway's HTTP answer, None when it did not answer: not the int
+        # LinecrewError.status this error would be served with.
+        self.status = status  # type: ignore[assignment]
         self.body = body  # the decoded JSON error ({"error", "message", "field"}), if any
 
 

@@ -25,7 +25,7 @@ import ground_station.planner as planner_pkg
 import linecrew.scenarios as scenarios_pkg
 from ground_station.planner.errors import PlanningProblemError
 from ground_station.planner.load import problem_from_obj
-from ground_station.planning import UavNow, build_problem
+from ground_station.planning import UavNow, build_problem, home_station
 from linecrew.planner_tools.cli import plan_main as planner_main
 from linecrew.scenarios import ScenarioError, load
 from proto.mission import ActionRecord, ActionState
@@ -95,7 +95,7 @@ def problem_of(scenario: Scenario) -> Any:
     uavs = [
         UavNow(
             uav_id=u.id,
-            position=site.station(u.home_station).position,
+            position=home_station(site, u).position,
             energy_wh=battery[u.type],
             available=True,
         )

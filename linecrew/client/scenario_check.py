@@ -81,7 +81,8 @@ def check(path: pathlib.Path) -> tuple[Scenario | None, list[Problem]]:
 
 def _check_actions(scenario: Scenario) -> list[Problem]:
     """Each scripted action as the ground station checks a submission."""
-    problems, accepted = [], []
+    problems: list[Problem] = []
+    accepted: list[ActionRecord] = []
     for i, scripted in enumerate(scenario.actions):
         prefix = f"$.actions[{i}]"
         try:

@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import dataclasses
 import datetime
+import functools
 import json
 import logging
 import pathlib
@@ -227,7 +228,7 @@ class LocalRun:
             groups.append((child, group))
         for child, group in groups:
             self.supervisor.wait_ready(
-                child, lambda g=group: self.agents_alive(g), self.options.start_timeout_s
+                child, functools.partial(self.agents_alive, group), self.options.start_timeout_s
             )
 
     def _agent_process(

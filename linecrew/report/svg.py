@@ -7,6 +7,7 @@ from __future__ import annotations
 import math
 from collections.abc import Iterable, Sequence
 from html import escape
+from typing import TypedDict
 
 from linecrew.report.data import Segment
 from proto.scenario import Scenario
@@ -23,6 +24,23 @@ KIND_COLOURS = {
 }
 RESULT_COLOURS = {"completed": "#2ca02c", "failed": "#d62728", "cancelled": "#7f7f7f"}
 FAILED = {"failed", "aborted"}
+
+
+class Box(TypedDict):
+    """A rectangle's attributes."""
+
+    x: float
+    y: float
+    width: float
+    height: float
+
+
+class Outline(TypedDict, total=False):
+    """A shape's paint attributes."""
+
+    fill: str
+    stroke: str
+    stroke_width: float
 
 
 def colour_of(index: int) -> str:
@@ -42,9 +60,9 @@ def el(tag: str, content: str = "", /, tip: str = "", **attrs: object) -> str:
     return f"<{tag}{''.join(parts)}>{inner}</{tag}>"
 
 
-def text(x: float, y: float, words: str, **attrs: object) -> str:
+def text(x: float, y: float, words: str, tip: str = "", **attrs: object) -> str:
     """A ``<text>`` at ``x, y``."""
-    return el("text", escape(words), x=float(x), y=float(y), **attrs)
+    return el("text", escape(words), tip=tip, x=float(x), y=float(y), **attrs)
 
 
 def points(coords: Iterable[tuple[float, float]]) -> str:
@@ -131,7 +149,7 @@ def site_map(
     for station in site.stations:
         x, y = at(station.position.x_m, station.position.y_m)
         tip = f"charging station {station.id} ({station.pads} pads)"
-        square = {"x": x - 6, "y": y - 6, "width": 12, "height": 12}
+        square: Box = {"x": x - 6, "y": y - 6, "width": 12, "height": 12}
         body.append(el("rect", tip=tip, **square, fill="#fff", stroke="#b8860b", stroke_width=2))
         body.append(text(x + 8, y + 12, station.id, fill="#b8860b"))
     for tools in site.tool_stations:
@@ -193,14 +211,16 @@ def gantt(
         for r, uav in enumerate(rows):
             top = y + r * row_h
             body.append(text(4, top + 14, uav))
-            lane = {"x": label_w, "y": top + 2, "width": plot_w, "height": row_h - 4}
+            lane: Box = {"x": label_w, "y": top + 2, "width": plot_w, "height": row_h - 4}
             body.append(el("rect", **lane, fill="#f4f4f4"))
             for s in (s for s in segments if s.uav_id == uav):
                 x0, x1 = x_of(s.start_s), x_of(s.end_s)
                 tip = f"{s.task_id} ({s.kind}) {s.start_s:.0f}-{s.end_s:.0f} s"
                 tip += (f" {s.result}" if s.result else "") + (f": {s.reason}" if s.reason else "")
-                bar = {"x": x0, "y": top + 3, "width": max(x1 - x0, 1.0), "height": row_h - 6}
-                outline = {"stroke": "#d62728", "stroke_width": 2} if s.result in FAILED else {}
+                bar: Box = {"x": x0, "y": top + 3, "width": max(x1 - x0, 1.0), "height": row_h - 6}
+                outline: Outline = (
+                    {"stroke": "#d62728", "stroke_width": 2} if s.result in FAILED else {}
+                )
                 colour = KIND_COLOURS.get(s.kind, "#999")
                 body.append(el("rect", tip=tip, **bar, fill=colour, **outline))
         y += len(rows) * row_h + 8
@@ -214,7 +234,7 @@ def gantt(
         body.append(el("rect", x=lx, y=y, width=12, height=10, fill=colour))
         body.append(text(lx + 16, y + 9, kind))
         lx += 90
-    failed = {"fill": "#fff", "stroke": "#d62728", "stroke_width": 2}
+    failed: Outline = {"fill": "#fff", "stroke": "#d62728", "stroke_width": 2}
     body.append(el("rect", x=lx, y=y, width=12, height=10, **failed))
     body.append(text(lx + 16, y + 9, "failed / aborted"))
     return svg(width, y + 16, body, "Gantt chart: executed and first plan")
@@ -238,7 +258,7 @@ def battery_curves(
     def at(t: float, f: float) -> tuple[float, float]:
         return left + (t - t0) / (t1 - t0) * plot_w, top + (1 - f) * plot_h
 
-    frame = {"x": left, "y": top, "width": plot_w, "height": plot_h}
+    frame: Box = {"x": left, "y": top, "width": plot_w, "height": plot_h}
     body = [el("rect", **frame, fill="#fbfbf8", stroke="#ddd")]
     for frac in (0.0, 0.25, 0.5, 0.75, 1.0):
         y = at(t0, frac)[1]

@@ -364,8 +364,8 @@ class MavlinkLink:
         then per message (one at a time: the ACKs carry no message id); a
         refusal only means the autopilot streams by default."""
         system, component = await self._wait_target()
-        for stream, hz in DATA_STREAMS_HZ.items():
-            self._conn.mav.request_data_stream_send(system, component, stream, hz, 1)
+        for stream, group_hz in DATA_STREAMS_HZ.items():
+            self._conn.mav.request_data_stream_send(system, component, stream, group_hz, 1)
         for name, hz in STREAMS_HZ.items():
             msg_id = getattr(mav, f"MAVLINK_MSG_ID_{name}")
             interval_us = 1e6 / hz

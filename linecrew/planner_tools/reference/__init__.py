@@ -37,6 +37,7 @@ or unavailable UAVs (refused as UNSUPPORTED).
 from __future__ import annotations
 
 import time
+from typing import TYPE_CHECKING
 
 import msgspec
 
@@ -46,6 +47,9 @@ from ground_station.planner.result import Plan
 from linecrew.planner_tools.reference.cpsat import Model
 from linecrew.planner_tools.reference.nodes import TICK_S, build_nodes, unsupported
 from linecrew.planner_tools.reference.steps import export, route_literals
+
+if TYPE_CHECKING:
+    from ortools.sat.python.cp_model import CpSolver
 
 __all__ = ["Reference", "solve"]
 
@@ -115,7 +119,7 @@ def solve(
     return out
 
 
-def _seed(m: Model, solver, hint: Plan, limit_s: float) -> bool:  # type: ignore[no-untyped-def]
+def _seed(m: Model, solver: CpSolver, hint: Plan, limit_s: float) -> bool:
     """Time ``hint``'s routes in the model and hint that whole solution."""
     lits = route_literals(m, hint)
     if lits is None:

@@ -3,9 +3,15 @@
 from __future__ import annotations
 
 from math import ceil, dist
+from typing import TYPE_CHECKING
 
 from ground_station.planner.model import MonitorAction, Problem, Uav
 from linecrew.planner_tools.reference.nodes import Node, clusters, nodes_of, ticks, units
+
+if TYPE_CHECKING:
+    from types import ModuleType
+
+    from ortools.sat.python.cp_model import IntVar, LinearExpr, LiteralT
 
 WEIGHT_SCALE = 100
 """Action weights are scaled to integers with this factor."""
@@ -15,13 +21,21 @@ class Model:
     """Variables and constraints, built in the constructor: per node its
     start, end, departure and energy; per UAV a circuit of arc literals."""
 
-    def __init__(self, cp, problem: Problem, nodes: list[Node], segments, horizon_s=None) -> None:  # type: ignore[no-untyped-def]
+    def __init__(
+        self,
+        cp: ModuleType,
+        problem: Problem,
+        nodes: list[Node],
+        segments: dict[tuple[str, int], list[int]],
+        horizon_s: float | None = None,
+    ) -> None:
+        """``cp`` is ``ortools.sat.python.cp_model`` (imported lazily by the caller)."""
         self.problem = problem
         self.nodes = nodes
         self.segments = segments
         self.types = {t.id: t for t in problem.uav_types}
         self.model = md = cp.CpModel()
-        self.actions = {a.id: a for a in problem.actions}
+        self.monitors = {a.id: a for a in problem.actions if isinstance(a, MonitorAction)}
         self.horizon = horizon = ticks(horizon_s) if horizon_s else self._horizon()
         n = len(nodes)
         self.start = [md.new_int_var(0, horizon, f"s{j}") for j in range(n)]
@@ -31,8 +45,8 @@ class Model:
         self.energy = [md.new_int_var(0, cap, f"e{j}") for j in range(n)]
         self.duration = [self._duration(j, horizon) for j in range(n)]
         self.home = {u.id: md.new_int_var(0, horizon, f"home_{u.id}") for u in problem.uavs}
-        self.arcs: dict[str, dict[tuple[int, int], object]] = {}
-        self.visit: dict[str, dict[int, object]] = {}
+        self.arcs: dict[str, dict[tuple[int, int], IntVar]] = {}
+        self.visit: dict[str, dict[int, IntVar]] = {}
         for u in problem.uavs:
             self._route(u)
         self._cover_once()
@@ -55,15 +69,16 @@ class Model:
         hops = len(self.nodes) + 2
         return ticks(span + hops * (far / slow + charge) + 3600)
 
-    def _duration(self, j: int, horizon: int):  # type: ignore[no-untyped-def]
+    def _duration(self, j: int, horizon: int) -> IntVar | int:
         node = self.nodes[j]
         md = self.model
+        d: IntVar | int
         if node.kind == "monitor" or (
-            node.kind == "recharge" and node.station.recharge == "charge"
+            node.kind == "recharge" and node.recharge_station.recharge == "charge"
         ):
             d = md.new_int_var(0, horizon, f"d{j}")
         elif node.kind == "recharge":
-            d = ticks(node.station.swap_s)
+            d = ticks(node.recharge_station.swap_s)
         else:
             d = node.service_s
         md.add(self.end[j] == self.start[j] + d)
@@ -80,12 +95,12 @@ class Model:
         cap = units(t.battery_wh)
         reserve = units(self.problem.reserve_fraction * t.battery_wh) + 1
         home = next(s for s in self.problem.stations if s.id == u.home_station).position_m
-        arcs: list[tuple[int, int, object]] = []
-        lits: dict[tuple[int, int], object] = {}
-        visit: dict[int, object] = {}
+        arcs: list[tuple[int, int, LiteralT]] = []
+        lits: dict[tuple[int, int], IntVar] = {}
+        visit: dict[int, IntVar] = {}
         used = md.new_bool_var(f"used_{u.id}")
         arcs.append((0, 0, ~used))
-        flights = []
+        flights: list[tuple[int, IntVar]] = []
         for j in mine:
             lit = md.new_bool_var(f"v_{u.id}_{j}")
             visit[j] = lit
@@ -111,10 +126,10 @@ class Model:
         md.add(self.home[u.id] >= sum(tt * lit for tt, lit in flights) + sum(busy.values()))
         self._energy_budget(u, flights, busy, reserve)
 
-    def _busy(self, u: Uav, visit: dict[int, object]) -> dict[int, object]:
+    def _busy(self, u: Uav, visit: dict[int, IntVar]) -> dict[int, LinearExpr | int]:
         """Per visit, the time ``u`` spends there (for the redundant workload
         bound: a UAV is home no earlier than its flights and visits add up to)."""
-        out = {}
+        out: dict[int, LinearExpr | int] = {}
         for j, lit in visit.items():
             d = self.duration[j]
             if isinstance(d, int):
@@ -126,7 +141,13 @@ class Model:
             out[j] = mine
         return out
 
-    def _energy_budget(self, u: Uav, flights, busy, reserve: int) -> None:  # type: ignore[no-untyped-def]
+    def _energy_budget(
+        self,
+        u: Uav,
+        flights: list[tuple[int, IntVar]],
+        busy: dict[int, LinearExpr | int],
+        reserve: int,
+    ) -> None:
         """Redundant: what ``u`` flies and hovers is at most its charge above
         the reserve plus what its recharges add (each at most to full, at a
         charge station at most the charging rate times its duration)."""
@@ -134,7 +155,7 @@ class Model:
         t = self.types[u.type]
         cap = units(t.battery_wh)
         flight, hover = ceil(t.flight_power_w), ceil(t.hover_power_w)
-        used = [flight * tt * lit for tt, lit in flights]
+        used: list[LinearExpr | int] = [flight * tt * lit for tt, lit in flights]
         gains = []
         for j, spent in busy.items():
             nd = self.nodes[j]
@@ -143,12 +164,12 @@ class Model:
                 continue
             g = md.new_int_var(0, cap - reserve, f"g_{u.id}_{j}")
             md.add(g <= (cap - reserve) * self.visit[u.id][j])
-            if nd.station.recharge == "charge":
-                md.add(g * ticks(nd.station.full_charge_s) <= cap * spent)
+            if nd.recharge_station.recharge == "charge":
+                md.add(g * ticks(nd.recharge_station.full_charge_s) <= cap * spent)
             gains.append(g)
         md.add(sum(used) <= units(u.energy_wh) - reserve + sum(gains))
 
-    def _arc(self, lit, u: Uav, i: int, j: int, tt: int, reserve: int) -> None:  # type: ignore[no-untyped-def]
+    def _arc(self, lit: IntVar, u: Uav, i: int, j: int, tt: int, reserve: int) -> None:
         """Arc ``i -> j`` (-1: the UAV's start, or the flight home). After a
         service the UAV hovers where it is until it leaves (``dep``), then
         flies straight to ``j``; before a recharge or home it leaves at once
@@ -171,7 +192,7 @@ class Model:
         if to_station:
             md.add(self.start[j] >= t_i + tt).only_enforce_if(lit)
             md.add(e_i - fly >= reserve).only_enforce_if(lit)
-            st = self.nodes[j].station
+            st = self.nodes[j].recharge_station
             if st.recharge == "charge":
                 md.add(self.duration[j] >= 1).only_enforce_if(lit)
                 full = ticks(st.full_charge_s)
@@ -210,9 +231,9 @@ class Model:
         """Slots of an action start together at ``t0``; a slot's segments
         follow each other with no gap (the relief arrives as the other leaves)."""
         md = self.model
-        self.t0 = {}
+        self.t0: dict[str, IntVar] = {}
         for (aid, _slot), js in self.segments.items():
-            a = self.actions[aid]
+            a = self.monitors[aid]
             if aid not in self.t0:
                 self.t0[aid] = md.new_int_var(0, self.horizon, f"t0_{aid}")
             md.add(self.start[js[0]] == self.t0[aid])
@@ -263,7 +284,7 @@ class Model:
                     iv = self.model.new_optional_interval_var(
                         self.start[j], self.duration[j], self.end[j], lit, f"pad{j}"
                     )
-                    by_station.setdefault(nd.station.id, []).append(iv)
+                    by_station.setdefault(nd.recharge_station.id, []).append(iv)
         stations = {s.id: s for s in self.problem.stations}
         for sid, ivs in by_station.items():
             if len(ivs) > stations[sid].pads:

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import dataclasses
 from math import ceil, dist
+from typing import Literal
 
 from ground_station.planner.model import (
     DeliverAction,
@@ -24,6 +25,7 @@ TICK_S = 0.1
 rounded up to whole ticks."""
 MAX_ARCS = 60_000
 """Refuse problems whose routing arcs (summed over UAVs) exceed this."""
+NodeKind = Literal["inspect", "monitor", "pick", "deliver", "recharge"]
 SERVICE_KIND = {"inspect": "inspect", "monitor": "monitor", "pick": "deliver", "deliver": "deliver"}
 
 
@@ -42,7 +44,7 @@ class Node:
     """One visit (times in ticks): a waypoint, a monitoring segment, a pick or drop, or a
     recharge (those belong to one UAV: ``owner``)."""
 
-    kind: str  # inspect | monitor | pick | deliver | recharge
+    kind: NodeKind
     pos: Vec3
     service_s: int = 0
     action_id: str | None = None
@@ -51,6 +53,13 @@ class Node:
     station: Station | None = None
     owner: str | None = None
     release_s: int = 0
+
+    @property
+    def recharge_station(self) -> Station:
+        """The station of a recharge node."""
+        if self.station is None:
+            raise ValueError(f"a {self.kind} node has no station")
+        return self.station
 
 
 def build_nodes(problem: Problem) -> tuple[list[Node], dict[tuple[str, int], list[int]]]:

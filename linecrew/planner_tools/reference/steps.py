@@ -3,24 +3,37 @@
 from __future__ import annotations
 
 from math import dist
+from typing import TYPE_CHECKING, TypedDict, Unpack
 
 import msgspec
 
 from ground_station.planner.metrics import compute_metrics
 from ground_station.planner.model import Station, Uav, UavType, Vec3
-from ground_station.planner.result import Plan, Step, UavPlan
+from ground_station.planner.result import Plan, Step, StepKind, UavPlan
 from linecrew.planner_tools.reference.cpsat import Model
 from linecrew.planner_tools.reference.nodes import TICK_S, Node, ticks
 
+if TYPE_CHECKING:
+    from ortools.sat.python.cp_model import CpSolver, LiteralT
 
-def export(m: Model, solver) -> Plan:  # type: ignore[no-untyped-def]
+
+class _Refs(TypedDict, total=False):
+    """What a step refers to: its station, or its action, index and tool."""
+
+    station: str
+    action_id: str | None
+    index: int | None
+    tool: str | None
+
+
+def export(m: Model, solver: CpSolver) -> Plan:
     """The solution as a plan document (times and energy in floats)."""
     uavs = tuple(UavPlan(uav_id=u.id, steps=tuple(_steps(m, solver, u))) for u in m.problem.uavs)
     plan = Plan(uavs=uavs)
     return msgspec.structs.replace(plan, metrics=compute_metrics(m.problem, plan))
 
 
-def _steps(m: Model, solver, u: Uav) -> list[Step]:  # type: ignore[no-untyped-def]
+def _steps(m: Model, solver: CpSolver, u: Uav) -> list[Step]:
     succ = {i: j for (i, j), lit in m.arcs[u.id].items() if solver.boolean_value(lit)}
     run = _Run(u, m.types[u.type], m.problem.now_s)
     i = -1
@@ -48,10 +61,12 @@ class _Run:
         d = dist(self.pos, to)
         return d, ticks(d / self.t.cruise_speed_mps) * TICK_S
 
-    def _step(self, kind: str, arrive: float, end: float, pos: Vec3, d: float, **kw) -> None:  # type: ignore[no-untyped-def]
+    def _step(
+        self, kind: StepKind, arrive: float, end: float, pos: Vec3, d: float, **kw: Unpack[_Refs]
+    ) -> None:
         self.steps.append(
             Step(
-                kind=kind,  # type: ignore[arg-type]
+                kind=kind,
                 start_s=self.time,
                 arrive_s=arrive,
                 end_s=end,
@@ -69,7 +84,7 @@ class _Run:
         d, tt = self._flight(nd.pos)
         if nd.kind == "recharge":
             self.e -= t.flight_power_w * tt / 3600.0
-            st = nd.station
+            st = nd.recharge_station
             if start > self.time + tt:  # wait landed at the station for a pad
                 self._step("wait", self.time + tt, start, nd.pos, d, station=st.id)
                 d = 0.0
@@ -98,13 +113,13 @@ class _Run:
         self._step("home", self.time + tt, self.time + tt, home.position_m, d, station=home.id)
 
 
-def route_literals(m: Model, plan: Plan) -> list | None:
+def route_literals(m: Model, plan: Plan) -> list[LiteralT] | None:
     """Literals fixing the routes of ``plan`` (every arc on or off), or None
     if the model cannot express them."""
     seqs = _sequences(m, plan)
     if seqs is None:
         return None
-    out = []
+    out: list[LiteralT] = []
     for uid, seq in seqs.items():
         on = set(zip([-1, *seq], [*seq, -1], strict=True))
         out += [lit if key in on else ~lit for key, lit in m.arcs[uid].items()]
@@ -128,16 +143,18 @@ def _sequences(m: Model, plan: Plan) -> dict[str, list[int]] | None:
         segment[(uid, n)] = rank[slot]
     out: dict[str, list[int]] = {}
     for up in plan.uavs:
-        free: dict[tuple, list[int]] = {}
+        free: dict[tuple[str, str | None, int | None], list[int]] = {}
         for j in m.visit.get(up.uav_id, {}):
             nd = m.nodes[j]
-            key = (nd.kind, nd.station.id if nd.station else nd.action_id, nd.index)
-            free.setdefault(key, []).append(j)
+            at = nd.station.id if nd.station else nd.action_id
+            free.setdefault((nd.kind, at, nd.index), []).append(j)
         seq: list[int] = []
         for n, s in enumerate(up.steps):
             if s.kind in ("wait", "home"):
                 continue
             if s.kind == "monitor":
+                if s.action_id is None or s.index is None:
+                    return None  # a monitoring step names its action and slot
                 js = m.segments.get((s.action_id, s.index), [])
                 h = segment[(up.uav_id, n)]
                 if h >= len(js) or js[h] not in m.visit[up.uav_id]:
