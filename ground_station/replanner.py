@@ -18,7 +18,6 @@ from ground_station import planner as pl
 from ground_station.event_log import EventLog
 from ground_station.fleet_monitor import FleetMonitor
 from ground_station.fleet_state import AIRBORNE, Docks, drop_done_home, flying_segments, uavs_now
-from ground_station.lifecycle import ActionEvent
 from ground_station.live_plan import (
     LivePlan,
     Objective,
@@ -29,6 +28,7 @@ from ground_station.live_plan import (
     frozen_tasks,
 )
 from ground_station.operator_control import OperatorControl
+from ground_station.placement import placement_events
 from ground_station.planning import (
     build_problem,
     capacity_wh,
@@ -49,9 +49,6 @@ log = logging.getLogger(__name__)
 CONVERGED = 0.001
 """An improvement attempt that gains less than this fraction over the last
 one has converged: no more attempts on this state."""
-
-IMPOSSIBLE = frozenset({"unreachable_with_full_battery", "unknown_tool"})
-"""Unplaced reasons that no change of fleet state can cure: the action fails."""
 
 
 class Replanner:
@@ -288,7 +285,7 @@ class Replanner:
                 detail=f"{job.reason}; {len(changed)} plan(s) changed in "
                 f"{elapsed * 1e3:.1f} ms ({how})",
             )
-        action_events = _action_events(job.records, new_tasks, result)
+        action_events = placement_events(job.records, new_tasks, result)
         self.waiting = {u.action_id for u in result.unplaced}
         return ReplanOutcome(epoch, changed, action_events, elapsed)
 
@@ -394,26 +391,3 @@ class Replanner:
     def _tasks(self, uav_id: str) -> list:
         plan = self.plans.get(uav_id)
         return plan.tasks if plan else []
-
-
-def _action_events(
-    records: list[ActionRecord], tasks: dict[str, list], result: pl.Plan
-) -> dict[str, tuple[ActionEvent, str]]:
-    placed = {t.action_id for plan_tasks in tasks.values() for t in plan_tasks if t.action_id}
-    unplaced: dict[str, list[pl.Unplaced]] = {}
-    for item in result.unplaced:
-        unplaced.setdefault(item.action_id, []).append(item)
-    events: dict[str, tuple[ActionEvent, str]] = {}
-    for record in records:
-        missing = unplaced.get(record.action_id, [])
-        reasons = ", ".join(sorted({m.reason for m in missing}))
-        if record.action_id in placed:
-            events[record.action_id] = (
-                ActionEvent.PLACED,
-                f"partly unplaced: {reasons}" if missing else "planned",
-            )
-        elif any(m.reason in IMPOSSIBLE for m in missing):
-            events[record.action_id] = (ActionEvent.IMPOSSIBLE, reasons)
-        else:
-            events[record.action_id] = (ActionEvent.UNPLACED, reasons or "not planned")
-    return events

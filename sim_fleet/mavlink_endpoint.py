@@ -25,8 +25,9 @@ flood of strangers cannot push the agent out of the table; a newcomer finds
 room only when a peer has gone quiet (counted in ``refused_peers``).
 
 Telemetry messages are built by ``mavlink_telemetry``, the mission protocol
-is ``mavlink_missions`` and AUTO's execution ``auto_mission`` (advanced from
-``tick``); all of them use this module's encoder.
+is ``mavlink_missions``, the parameter protocol ``mavlink_params`` and AUTO's
+execution ``auto_mission`` (advanced from ``tick``); all of them use this
+module's encoder.
 """
 
 from __future__ import annotations
@@ -36,6 +37,7 @@ import logging
 import math
 import os
 import time
+from collections.abc import Callable
 from typing import Any, cast
 
 os.environ["MAVLINK20"] = "1"  # for any mavutil user in this process; we use the v20 dialect
@@ -46,6 +48,7 @@ from sim_fleet import autopilot, frames, mavlink_telemetry, streams
 from sim_fleet.auto_mission import AutoMission
 from sim_fleet.events import Outcome, Result, Severity
 from sim_fleet.mavlink_missions import MissionProtocol
+from sim_fleet.mavlink_params import ParamProtocol
 from sim_fleet.modes import FLAG_CUSTOM_MODE_ENABLED, Mode
 from sim_fleet.vehicle import Vehicle
 from sim_fleet.world import World
@@ -103,6 +106,20 @@ class VehicleEndpoint(asyncio.DatagramProtocol):
         self._home_sent = 0  # the vehicle's home_version last broadcast
         self.auto = AutoMission(world, vehicle)
         self.missions = MissionProtocol(self._mav, self._send_to, self.auto)
+        self.params = ParamProtocol(self._mav, self._send_to, vehicle, self._all_peers)
+        # message type -> what a message of that type addressed to this vehicle does
+        self._handlers: dict[str, Callable[[Any, Addr], None]] = {
+            "COMMAND_LONG": self._command_long,
+            "COMMAND_INT": self._command_int,
+            "SET_MODE": self._set_mode_message,
+            "SET_POSITION_TARGET_GLOBAL_INT": self._global_target,
+            "SET_POSITION_TARGET_LOCAL_NED": self._local_target,
+            "REQUEST_DATA_STREAM": self._request_data_stream,
+            **dict.fromkeys(MISSION_MESSAGES, self.missions.handle),
+            "PARAM_REQUEST_LIST": self.params.request_list,
+            "PARAM_REQUEST_READ": self.params.request_read,
+            "PARAM_SET": self.params.set,
+        }
         self._transport: asyncio.DatagramTransport | None = None
 
     # ---- asyncio protocol ------------------------------------------------
@@ -157,6 +174,10 @@ class VehicleEndpoint(asyncio.DatagramProtocol):
             del self.peers[oldest]
         self.peers[addr] = now
 
+    def _all_peers(self) -> list[Addr]:
+        """Every peer that gets telemetry: the static ones, then the learned."""
+        return [*self.static_peers, *self.peers]
+
     # ---- incoming --------------------------------------------------------
     def _for_me(self, msg: Any) -> bool:
         return msg.target_system in (0, self.vehicle.sysid) and msg.target_component in (
@@ -165,60 +186,37 @@ class VehicleEndpoint(asyncio.DatagramProtocol):
         )
 
     def _handle(self, msg: Any, addr: Addr) -> None:
-        match msg.get_type():
-            case "COMMAND_LONG" if self._for_me(msg):
-                p = (
-                    msg.param1,
-                    msg.param2,
-                    msg.param3,
-                    msg.param4,
-                    msg.param5,
-                    msg.param6,
-                    msg.param7,
-                )
-                self._command(autopilot.Command(msg.command, p), msg, addr)
-            case "COMMAND_INT" if self._for_me(msg):
-                p = (
-                    msg.param1,
-                    msg.param2,
-                    msg.param3,
-                    msg.param4,
-                    float(msg.x),
-                    float(msg.y),
-                    msg.z,
-                )
-                self._command(autopilot.Command(msg.command, p, msg.frame), msg, addr)
-            case "SET_MODE" if msg.target_system == self.vehicle.sysid:
-                outcome = self._set_mode(msg.base_mode, msg.custom_mode)
-                self._ack(mav.MAVLINK_MSG_ID_SET_MODE, outcome, msg, addr)
-            case "SET_POSITION_TARGET_GLOBAL_INT" if self._for_me(msg):
-                self._global_target(msg)
-            case "SET_POSITION_TARGET_LOCAL_NED" if self._for_me(msg):
-                self._local_target(msg)
-            case "REQUEST_DATA_STREAM" if self._for_me(msg):
-                rate = float(msg.req_message_rate)
-                self.schedule.request_data_stream(msg.req_stream_id, rate, bool(msg.start_stop))
-            case kind if kind in MISSION_MESSAGES and self._for_me(msg):
-                self.missions.handle(msg, addr)
-            case "PARAM_REQUEST_LIST" if self._for_me(msg):
-                for param in self.vehicle.parameters.all():
-                    self._send_to([addr], self._param_value(param.name))
-            case "PARAM_REQUEST_READ" if self._for_me(msg):
-                params = self.vehicle.parameters
-                name = msg.param_id if msg.param_index < 0 else None
-                if name is None:
-                    by_index = params.by_index(msg.param_index)
-                    name = by_index.name if by_index is not None else None
-                if name is not None and name in params:
-                    self._send_to([addr], self._param_value(name))
-            case "PARAM_SET" if self._for_me(msg):
-                if autopilot.set_param(self.vehicle, msg.param_id, msg.param_value):
-                    peers = list(dict.fromkeys([addr, *self.static_peers, *self.peers]))
-                    self._send_to(peers, self._param_value(msg.param_id))
-                elif msg.param_id in self.vehicle.parameters:  # read-only: echo the value
-                    self._send_to([addr], self._param_value(msg.param_id))
-            case _:
-                pass  # HEARTBEAT and everything else: only makes the sender a peer
+        """Act on a message addressed to this vehicle; HEARTBEAT and everything
+        else only made the sender a peer."""
+        handler = self._handlers.get(msg.get_type())
+        if handler is not None and self._addressed(msg):
+            handler(msg, addr)
+
+    def _addressed(self, msg: Any) -> bool:
+        """Whether ``msg`` is for this vehicle (SET_MODE names only a system)."""
+        if msg.get_type() == "SET_MODE":
+            return bool(msg.target_system == self.vehicle.sysid)
+        return self._for_me(msg)
+
+    def _command_long(self, msg: Any, addr: Addr) -> None:
+        """COMMAND_LONG: a command with its location in degrees, relative altitude."""
+        p = (msg.param1, msg.param2, msg.param3, msg.param4, msg.param5, msg.param6, msg.param7)
+        self._command(autopilot.Command(msg.command, p), msg, addr)
+
+    def _command_int(self, msg: Any, addr: Addr) -> None:
+        """COMMAND_INT: a command with its location in ``msg.frame`` (lat/lon in 1e-7 degrees)."""
+        p = (msg.param1, msg.param2, msg.param3, msg.param4, float(msg.x), float(msg.y), msg.z)
+        self._command(autopilot.Command(msg.command, p, msg.frame), msg, addr)
+
+    def _set_mode_message(self, msg: Any, addr: Addr) -> None:
+        """SET_MODE, acknowledged like a command."""
+        outcome = self._set_mode(msg.base_mode, msg.custom_mode)
+        self._ack(mav.MAVLINK_MSG_ID_SET_MODE, outcome, msg, addr)
+
+    def _request_data_stream(self, msg: Any, _addr: Addr) -> None:
+        """REQUEST_DATA_STREAM: start or stop an ArduPilot stream group."""
+        rate = float(msg.req_message_rate)
+        self.schedule.request_data_stream(msg.req_stream_id, rate, bool(msg.start_stop))
 
     def _command(self, cmd: autopilot.Command, msg: Any, addr: Addr) -> None:
         p = cmd.params
@@ -294,7 +292,9 @@ class VehicleEndpoint(asyncio.DatagramProtocol):
         )
         self._send_to([addr], ack)
 
-    def _global_target(self, msg: Any) -> None:
+    def _global_target(self, msg: Any, _addr: Addr) -> None:
+        """SET_POSITION_TARGET_GLOBAL_INT: fly to a position or at a velocity
+        (a target that makes no sense holds)."""
         v = self.vehicle
         pos = vel = None
         if not msg.type_mask & POS_IGNORE:
@@ -313,7 +313,8 @@ class VehicleEndpoint(asyncio.DatagramProtocol):
                 return
         autopilot.position_target(v, pos, vel)
 
-    def _local_target(self, msg: Any) -> None:
+    def _local_target(self, msg: Any, _addr: Addr) -> None:
+        """SET_POSITION_TARGET_LOCAL_NED: as :meth:`_global_target`, in a local frame."""
         v = self.vehicle
         frame = msg.coordinate_frame
         pos = vel = None
@@ -341,7 +342,7 @@ class VehicleEndpoint(asyncio.DatagramProtocol):
         if not self.vehicle.link_up() or self._transport is None:
             return
         self.missions.tick()
-        peers = [*self.static_peers, *self.peers]
+        peers = self._all_peers()
         if not peers:
             return
         for t in texts:
@@ -365,15 +366,6 @@ class VehicleEndpoint(asyncio.DatagramProtocol):
                 self._transport.sendto(buf, addr)
             except OSError as exc:
                 log.debug("%s: send to %s failed: %s", self.vehicle.id, addr, exc)
-
-    def _param_value(self, name: str) -> Any:
-        params = self.vehicle.parameters
-        p = params.param(name)
-        if p is None:
-            return None
-        return self._mav.param_value_encode(
-            p.name.encode("ascii"), p.value, p.type, len(params), params.index_of(name)
-        )
 
     def _statustext(self, severity: int, text: str) -> Any:
         return self._mav.statustext_encode(severity, text.encode("ascii", "replace")[:50])

@@ -29,16 +29,15 @@ import sys
 import tempfile
 import threading
 import time
-from collections.abc import Callable
 
 import msgspec
 
 from linecrew.bench.child import wait_ready
 from linecrew.bench.light_agent import LightAgent
+from linecrew.bench.plan_stability import EventWatch, measure_stability, settle
 from linecrew.bus import Bus, BusConfig
 from linecrew.bus.router_process import router_process
 from linecrew.latency import percentile_ms
-from linecrew.launch.proc_stats import cpu_s
 from linecrew.scenarios import load, with_fleet_size
 from proto import (
     ActionList,
@@ -46,7 +45,6 @@ from proto import (
     ActionState,
     EventKind,
     GetMetrics,
-    GsEvent,
     InspectAction,
     KeySpace,
     ListActions,
@@ -104,40 +102,11 @@ def _preload(
     return time.perf_counter() - started
 
 
-class _EventWatch:
-    """Collects ground-station events with their arrival times."""
-
-    def __init__(self, bus: Bus, keys: KeySpace) -> None:
-        self.items: list[tuple[float, GsEvent]] = []
-        self._cond = threading.Condition()
-        bus.subscribe(keys.events(), GsEvent, self._on_event)
-
-    def _on_event(self, _key: str, event: GsEvent) -> None:
-        with self._cond:
-            self.items.append((time.perf_counter(), event))
-            self._cond.notify_all()
-
-    def wait_for(
-        self, predicate: Callable[[GsEvent], bool], timeout_s: float, since: float = 0.0
-    ) -> tuple[float, GsEvent] | None:
-        """The first (time, event) after ``since`` satisfying ``predicate``."""
-        deadline = time.monotonic() + timeout_s
-        with self._cond:
-            while True:
-                found = next(
-                    (item for item in self.items if item[0] >= since and predicate(item[1])), None
-                )
-                remaining = deadline - time.monotonic()
-                if found or remaining <= 0:
-                    return found
-                self._cond.wait(remaining)
-
-
 def _event_to_plan(
     client: Bus,
     keys: KeySpace,
     agents: dict[str, LightAgent],
-    watch: _EventWatch,
+    watch: EventWatch,
     events: int,
     seed: int,
     replies: list[float],
@@ -175,66 +144,6 @@ def _event_to_plan(
     return latencies
 
 
-def _improvements(watch: _EventWatch, since: float) -> set[int | None]:
-    """Epochs of the improvements adopted since ``since``."""
-    return {
-        e.epoch
-        for t, e in watch.items
-        if e.kind == EventKind.REPLAN and t >= since and e.detail.startswith("improvement")
-    }
-
-
-def _settle(client: Bus, keys: KeySpace, timeout_s: float = 120.0) -> float:
-    """Wait until the gs's plan is final (the background improvement of the
-    last trigger's state done); returns the seconds it took."""
-    started = time.perf_counter()
-    while time.perf_counter() - started < timeout_s:
-        metrics = client.query(keys.rpc("metrics"), GetMetrics(), MetricsReply, 10.0)
-        if metrics.values.get("planner_settled") == 1.0:
-            break
-        time.sleep(0.1)
-    return time.perf_counter() - started
-
-
-def _stability(
-    client: Bus,
-    keys: KeySpace,
-    watch: _EventWatch,
-    since: float,
-    counts: tuple[int, int],
-    steady_s: float,
-    gs_pid: int,
-) -> dict[str, float]:
-    """Epochs per trigger during the submissions (from ``since``), how long
-    the improvement of the last state ran, then epochs per UAV per minute and
-    the gs's CPU while nothing happens (the gs runs at x1)."""
-    uavs, events = counts
-    settle_s = _settle(client, keys)
-    quiet_from = time.perf_counter()
-    changes = [(t, e) for t, e in watch.items if e.kind == EventKind.PLAN_CHANGED]
-    improved = _improvements(watch, since)
-    epochs = {e.epoch for t, e in changes if t >= since} - improved
-    before = {e.epoch for t, e in changes if t < since}
-    cpu = cpu_s(gs_pid)
-    time.sleep(steady_s)
-    cpu = cpu_s(gs_pid) - cpu
-    improved = _improvements(watch, since)  # adopted late: counted apart, not as steady
-    quiet = {
-        e.epoch
-        for t, e in watch.items
-        if e.kind == EventKind.PLAN_CHANGED
-        and t >= quiet_from
-        and e.epoch not in epochs | before | improved
-    }
-    return {
-        "epochs_per_submit": len(epochs) / max(1, events),
-        "improvement_epochs": float(len(improved)),
-        "improvement_settle_s": settle_s,
-        "steady_epochs_per_uav_min": len(quiet) / uavs / (steady_s / 60.0),
-        "steady_gs_cpu_pct": 100.0 * cpu / steady_s,
-    }
-
-
 def doomed_agent(endpoint: str, scenario_file: str, uav_id: str, lease_ms: int) -> None:
     """Child-process body: a light agent (token + 5 Hz telemetry) until killed."""
     scenario = msgspec.json.decode(pathlib.Path(scenario_file).read_bytes(), type=Scenario)
@@ -249,7 +158,7 @@ def _silence_to_lost(
     scenario_file: str,
     uav_id: str,
     lease_ms: int,
-    watch: _EventWatch,
+    watch: EventWatch,
 ) -> dict[str, float]:
     code = (
         f"from linecrew.bench.ground_station import doomed_agent; "
@@ -315,7 +224,7 @@ def run(
         agents: dict[str, LightAgent] = {}
         try:
             with Bus.open(config) as client:
-                watch = _EventWatch(client, keys)
+                watch = EventWatch(client, keys)
                 deadline = time.monotonic() + 20
                 while not client.alive(keys.all_alive(Role.GROUND_STATION)):
                     if time.monotonic() > deadline:
@@ -327,12 +236,12 @@ def run(
                     time.sleep(0.01)
                 replies: list[float] = []
                 preload_s = _preload(client, keys, preload, seed, replies, 120.0)
-                _settle(client, keys)  # the background improvement of the loaded plan
+                settle(client, keys)  # the background improvement of the loaded plan
                 submitted = time.perf_counter()
                 latencies = sorted(
                     _event_to_plan(client, keys, agents, watch, events, seed, replies)
                 )
-                stability = _stability(
+                stability = measure_stability(
                     client, keys, watch, submitted, (uavs, events), steady_s, gs.pid
                 )
                 lost = _silence_to_lost(

@@ -18,6 +18,7 @@ from __future__ import annotations
 
 import dataclasses
 import random
+from collections.abc import Callable
 from typing import Any
 
 from linecrew.chaos.cuts import burst, cut_target
@@ -100,79 +101,134 @@ def make_schedule(
     ``mix``: other weights than :data:`WEIGHTS` (a focused run).
     Pure: the same arguments give the same list."""
     rng = random.Random(seed)
-    uavs = [u.id for u in scenario.fleet.uavs]
+    drawing = _Drawing(
+        rng=rng,
+        seed=seed,
+        scenario=scenario,
+        uavs=[u.id for u in scenario.fleet.uavs],
+        netns=netns,
+        used_tools={a.action.tool for a in scenario.actions if hasattr(a.action, "tool")},
+    )
     mix = WEIGHTS if mix is None else mix
     kinds = sorted(k for k in mix if mix[k] > 0)
     weights = [mix[k] for k in kinds]
     schedule: list[Injection] = []
     t = rng.uniform(3.0, 6.0)
     disruption_free_s = 0.0  # when the last disruption has healed
-    serial = 0
-    used_tools = {a.action.tool for a in scenario.actions if hasattr(a.action, "tool")}
-    submitted: dict[str, dict[str, Any]] = {}  # chaos action id -> its body
-    fallen = False  # a motor fault was scheduled
     while t < duration_s:
         kind = rng.choices(kinds, weights)[0]
         if kind in DISRUPTIONS:
             t = max(t, disruption_free_s + rng.uniform(2.0, 5.0))
             if t >= duration_s:
                 break
-        at_s = round(t, 2)
-        if kind in DISRUPTIONS:
-            hold = _hold_s(rng, kind)
-            target = rng.choice(uavs) if kind in UAV_TARGETED else ""
-            params: dict[str, Any] = {}
-            if kind in CUTS:
-                target = cut_target(rng, uavs, netns)
-            if kind == "cut_burst":
-                params = {"cuts": burst(rng)}
-                hold = round(sum(params["cuts"][-1]), 2)
-            elif kind == "replan_kill_router":
-                serial += 1
-                action = _random_action(rng, scenario, f"chaos-{seed}-{serial}", used_tools)
-                kill_after = round(rng.uniform(0.05, 0.5), 2)
-                params = {"action": action, "kill_after_s": kill_after, "down_s": hold}
-                hold = round(kill_after + hold, 2)
-            elif kind == "clock_jump":
-                params = {"offset_s": rng.choice([-1, 1]) * round(rng.uniform(2.0, 30.0))}
-            elif kind == "disk":
-                serial += 1
-                params = _random_action(rng, scenario, f"chaos-{seed}-{serial}", used_tools)
-            schedule.append(
-                Injection(at_s=at_s, kind=kind, target=target, hold_s=hold, params=params)
-            )
-            disruption_free_s = t + hold
-        elif kind == "battery":
-            fraction = round(rng.uniform(0.3, 0.7), 2)
-            schedule.append(
-                Injection(
-                    at_s=at_s, kind=kind, target=rng.choice(uavs), params={"fraction": fraction}
-                )
-            )
-        elif kind == "gps":
-            hold = round(rng.uniform(0.5, 3.0), 2)
-            schedule.append(Injection(at_s=at_s, kind=kind, target=rng.choice(uavs), hold_s=hold))
-        elif kind == "motor":
-            if fallen or len(uavs) < 2:
-                continue  # the draw is spent; the next one picks again at the same time
-            fallen = True
-            schedule.append(Injection(at_s=at_s, kind=kind, target=rng.choice(uavs)))
-        elif kind in {"cancel", "edit"}:
-            if not submitted:
-                continue
-            action_id = rng.choice(list(submitted)[-2:])  # a recent one: likely still live
-            params = {"change": _edit(rng, submitted[action_id])} if kind == "edit" else {}
-            hold = round(rng.uniform(2.0, 6.0), 2)
-            schedule.append(
-                Injection(at_s=at_s, kind=kind, target=action_id, hold_s=hold, params=params)
-            )
+            disruption = _disruption(drawing, kind, round(t, 2))
+            disruption_free_s = t + disruption.hold_s
+            schedule.append(disruption)
         else:
-            serial += 1
-            params = _random_action(rng, scenario, f"chaos-{seed}-{serial}", used_tools)
-            submitted[params["action_id"]] = params
-            schedule.append(Injection(at_s=at_s, kind=kind, params=params))
+            drawn = _OTHERS.get(kind, _new_action)(drawing, kind, round(t, 2))
+            if drawn is None:
+                continue  # the draw is spent; the next one picks again at the same time
+            schedule.append(drawn)
         t += rng.uniform(1.5, 6.0)
     return schedule
+
+
+@dataclasses.dataclass(kw_only=True)
+class _Drawing:
+    """What the draws of one schedule share: its random stream and fleet, and
+    what earlier draws decided that later ones depend on."""
+
+    rng: random.Random
+    seed: int
+    scenario: Scenario
+    uavs: list[str]
+    netns: bool
+    used_tools: set[str]  # the scenario's and chaos deliveries' tools: each goes once
+    serial: int = 0  # of the last chaos action
+    # chaos action id -> its body
+    submitted: dict[str, dict[str, Any]] = dataclasses.field(default_factory=dict)
+    fallen: bool = False  # a motor fault was scheduled
+
+    def action_body(self) -> dict[str, Any]:
+        """The body of a new chaos action, under the next serial."""
+        self.serial += 1
+        action_id = f"chaos-{self.seed}-{self.serial}"
+        return _random_action(self.rng, self.scenario, action_id, self.used_tools)
+
+
+def _disruption(d: _Drawing, kind: str, at_s: float) -> Injection:
+    """One of :data:`DISRUPTIONS` at ``at_s``; its ``hold_s`` is how long it
+    lasts (until healed, restarted or its probe re-checked)."""
+    rng = d.rng
+    hold = _hold_s(rng, kind)
+    target = rng.choice(d.uavs) if kind in UAV_TARGETED else ""
+    params: dict[str, Any] = {}
+    if kind in CUTS:
+        target = cut_target(rng, d.uavs, d.netns)
+    if kind == "cut_burst":
+        params = {"cuts": burst(rng)}
+        hold = round(sum(params["cuts"][-1]), 2)
+    elif kind == "replan_kill_router":
+        action = d.action_body()
+        kill_after = round(rng.uniform(0.05, 0.5), 2)
+        params = {"action": action, "kill_after_s": kill_after, "down_s": hold}
+        hold = round(kill_after + hold, 2)
+    elif kind == "clock_jump":
+        params = {"offset_s": rng.choice([-1, 1]) * round(rng.uniform(2.0, 30.0))}
+    elif kind == "disk":
+        params = d.action_body()
+    return Injection(at_s=at_s, kind=kind, target=target, hold_s=hold, params=params)
+
+
+def _battery(d: _Drawing, kind: str, at_s: float) -> Injection:
+    """A UAV's battery drops to a fraction between 0.3 and 0.7."""
+    fraction = round(d.rng.uniform(0.3, 0.7), 2)
+    return Injection(
+        at_s=at_s, kind=kind, target=d.rng.choice(d.uavs), params={"fraction": fraction}
+    )
+
+
+def _gps(d: _Drawing, kind: str, at_s: float) -> Injection:
+    """A UAV's GPS frozen for 0.5 to 3 s."""
+    hold = round(d.rng.uniform(0.5, 3.0), 2)
+    return Injection(at_s=at_s, kind=kind, target=d.rng.choice(d.uavs), hold_s=hold)
+
+
+def _motor(d: _Drawing, kind: str, at_s: float) -> Injection | None:
+    """A UAV's motors fail; None (the draw is spent) once one has, or with a
+    single UAV, so that another can always take over its work."""
+    if d.fallen or len(d.uavs) < 2:
+        return None
+    d.fallen = True
+    return Injection(at_s=at_s, kind=kind, target=d.rng.choice(d.uavs))
+
+
+def _amend(d: _Drawing, kind: str, at_s: float) -> Injection | None:
+    """A cancel or an edit of one of the two latest chaos actions (likely
+    still live); None (the draw is spent) before the first one."""
+    if not d.submitted:
+        return None
+    action_id = d.rng.choice(list(d.submitted)[-2:])
+    params = {"change": _edit(d.rng, d.submitted[action_id])} if kind == "edit" else {}
+    hold = round(d.rng.uniform(2.0, 6.0), 2)
+    return Injection(at_s=at_s, kind=kind, target=action_id, hold_s=hold, params=params)
+
+
+def _new_action(d: _Drawing, kind: str, at_s: float) -> Injection:
+    """A new chaos action, remembered for later cancels and edits."""
+    params = d.action_body()
+    d.submitted[params["action_id"]] = params
+    return Injection(at_s=at_s, kind=kind, params=params)
+
+
+_OTHERS: dict[str, Callable[[_Drawing, str, float], Injection | None]] = {
+    "battery": _battery,
+    "gps": _gps,
+    "motor": _motor,
+    "cancel": _amend,
+    "edit": _amend,
+}
+"""Draws of the kinds that are not disruptions (any other kind: a new action)."""
 
 
 def _edit(rng: random.Random, body: dict[str, Any]) -> dict[str, Any]:
