@@ -30,7 +30,7 @@ from enum import IntEnum
 from sim_fleet import autopilot, frames, physics
 from sim_fleet.events import ACCEPTED, Outcome, Result, Severity
 from sim_fleet.modes import FlightState, Mode
-from sim_fleet.scenario import Vec3
+from sim_fleet.physics import Vec3
 from sim_fleet.vehicle import AIRBORNE, Vehicle
 from sim_fleet.world import World
 

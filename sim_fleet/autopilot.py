@@ -22,7 +22,7 @@ from sim_fleet.modes import (
     FlightState,
     Mode,
 )
-from sim_fleet.scenario import Vec3
+from sim_fleet.physics import Vec3
 from sim_fleet.vehicle import AIRBORNE, Vehicle
 
 # MAV_CMD numbers handled here
@@ -159,11 +159,11 @@ def change_speed(vehicle: Vehicle, speed_type: int, speed_mps: float) -> Outcome
         return FAILED  # the mode has no speed to set
     t = vehicle.type
     if speed_type in (0, 1):
-        vehicle.speed_mps = min(speed_mps, t.speed_cap_mps)
+        vehicle.speed_mps = min(speed_mps, 2.0 * t.cruise_speed_mps)
     elif speed_type == 2:
         vehicle.climb_mps = min(speed_mps, 2.0 * t.climb_rate_mps)
     else:
-        vehicle.descent_mps = min(speed_mps, 2.0 * t.descent_rate_mps)
+        vehicle.descent_mps = min(speed_mps, 2.0 * t.climb_rate_mps)
     return ACCEPTED
 
 
@@ -207,11 +207,11 @@ def set_param(vehicle: Vehicle, name: str, value: float) -> bool:
         return False
     t = vehicle.type
     if name == "WPNAV_SPEED" and value > 0:
-        vehicle.speed_mps = min(value / 100.0, t.speed_cap_mps)
+        vehicle.speed_mps = min(value / 100.0, 2.0 * t.cruise_speed_mps)
     elif name == "WPNAV_SPEED_UP" and value > 0:
         vehicle.climb_mps = min(value / 100.0, 2.0 * t.climb_rate_mps)
     elif name == "WPNAV_SPEED_DN" and value > 0:
-        vehicle.descent_mps = min(value / 100.0, 2.0 * t.descent_rate_mps)
+        vehicle.descent_mps = min(value / 100.0, 2.0 * t.climb_rate_mps)
     return True
 
 

@@ -8,6 +8,8 @@ import bisect
 _SOC_POINTS = (0.0, 0.05, 0.10, 0.20, 0.40, 0.60, 0.80, 0.90, 1.0)
 _CELL_VOLTS = (3.30, 3.50, 3.60, 3.70, 3.78, 3.85, 3.98, 4.08, 4.20)
 NOMINAL_CELL_V = 3.7
+CELLS = 4
+"""LiPo cells in series in every simulated pack."""
 INTERNAL_RESISTANCE_OHM_PER_CELL = 0.005
 
 
@@ -25,7 +27,7 @@ def cell_voltage(soc: float) -> float:
 class Battery:
     """Energy in watt-hours; ``load_w`` is the power being drawn right now."""
 
-    def __init__(self, capacity_wh: float, soc: float = 1.0, cells: int = 4) -> None:
+    def __init__(self, capacity_wh: float, soc: float = 1.0, cells: int = CELLS) -> None:
         if capacity_wh <= 0:
             raise ValueError("capacity_wh must be positive")
         self.capacity_wh = capacity_wh

@@ -28,8 +28,8 @@ from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from typing import TypeVar
 
+from proto.scenario import Scenario
 from sim_fleet.mavlink_endpoint import Addr, VehicleEndpoint
-from sim_fleet.scenario import Scenario
 from sim_fleet.streams import TelemetryRates
 from sim_fleet.vehicle import AutopilotParams
 from sim_fleet.world import World

@@ -11,7 +11,7 @@ from __future__ import annotations
 import math
 
 from sim_fleet.geo import GeoFrame
-from sim_fleet.scenario import Vec3
+from sim_fleet.physics import Vec3
 
 # MAV_FRAME
 GLOBAL = 0

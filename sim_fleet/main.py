@@ -24,7 +24,6 @@ from proto.scenario import Scenario
 from proto.sim import GetSimState, SimFault
 from sim_fleet.faults import apply_fault
 from sim_fleet.fleet import Fleet, FleetConfig
-from sim_fleet.from_proto import scenario_from_proto
 from sim_fleet.spot_control import SpotControl, SpotService
 from sim_fleet.streams import TelemetryRates
 from sim_fleet.tracker import HumanTracker
@@ -52,12 +51,7 @@ async def serve(
         "simulating %d UAVs at x%g", len(fleet.endpoints), speedup, extra={"ports": fleet.ports}
     )
     tracker = HumanTracker(scenario.site, world, bus, mission_clock(speedup))
-    sites = fleet.world.scenario.stations
-    control = SpotControl(
-        {s.id: s.spot_points for s in sites},
-        world.rules.dock_radius_m,
-        owners={s.id: s.owners for s in sites},
-    )
+    control = SpotControl(world.spots, world.rules.dock_radius_m, owners=world.spot_owners)
     stations = SpotService(control, world, bus, keys)
     async with asyncio.TaskGroup() as group:
         running = group.create_task(fleet.run())
@@ -135,7 +129,7 @@ def main(argv: list[str] | None = None) -> int:
         rates=TelemetryRates(stream_by_default=args.stream_by_default),
         signing_keys=keys,
     )
-    fleet = Fleet(scenario_from_proto(scenario.site, scenario.fleet), config)
+    fleet = Fleet(scenario, config)
     with bus:
         code = asyncio.run(serve(scenario, fleet, bus, shutdown, args.id, args.pose_hz))
     log.info("simulator stopped on %s", shutdown.signal_name or "request")

@@ -13,7 +13,7 @@ from typing import Any, NamedTuple
 
 from sim_fleet import streams
 from sim_fleet.modes import LANDED_STATE, base_mode, system_status
-from sim_fleet.scenario import Vec3
+from sim_fleet.physics import Vec3
 from sim_fleet.vehicle import Vehicle
 from sim_fleet.world import World
 

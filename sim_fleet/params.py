@@ -12,8 +12,10 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
+from sim_fleet.battery import CELLS, NOMINAL_CELL_V
+
 if TYPE_CHECKING:
-    from sim_fleet.scenario import VehicleType
+    from proto.fleet import UavType
     from sim_fleet.vehicle import AutopilotParams
 
 # MAV_PARAM_TYPE
@@ -68,9 +70,9 @@ class ParamStore:
         return p
 
 
-def vehicle_parameters(sysid: int, t: VehicleType, p: AutopilotParams) -> list[Param]:
+def vehicle_parameters(sysid: int, t: UavType, p: AutopilotParams) -> list[Param]:
     """A vehicle's parameter file: ArduCopter names and units."""
-    cells_v = 3.7 * t.cells
+    cells_v = NOMINAL_CELL_V * CELLS
     return [
         Param("SYSID_THISMAV", float(sysid), INT16, read_only=True),
         Param("FRAME_CLASS", 1.0, INT8, read_only=True),  # quad
@@ -78,10 +80,10 @@ def vehicle_parameters(sysid: int, t: VehicleType, p: AutopilotParams) -> list[P
         Param("DISARM_DELAY", float(p.auto_disarm_s or 0), INT8),
         Param("GRIP_ENABLE", 1.0 if t.gripper else 0.0, INT8),
         Param("RTL_ALT", round(p.rtl_alt_m * 100), INT32),
-        Param("LAND_SPEED", round(t.land_speed_mps * 100), INT16),
+        Param("LAND_SPEED", round(p.land_speed_mps * 100), INT16),
         Param("WPNAV_SPEED", t.cruise_speed_mps * 100, REAL32),
         Param("WPNAV_SPEED_UP", t.climb_rate_mps * 100, REAL32),
-        Param("WPNAV_SPEED_DN", t.descent_rate_mps * 100, REAL32),
+        Param("WPNAV_SPEED_DN", t.climb_rate_mps * 100, REAL32),
         Param("BATT_CAPACITY", float(round(t.battery_wh / cells_v * 1000)), INT32, read_only=True),
         Param("BATT_ARM_MAH", 0.0, INT32),
         Param("SIM_WARMUP_S", p.warmup_s, REAL32, read_only=True),  # not ArduCopter's: the sim's

@@ -10,7 +10,8 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from sim_fleet.scenario import Vec3
+Vec3 = tuple[float, float, float]
+"""A position or velocity: site metres (east, north, up), or per second."""
 
 GRAVITY_MPS2 = 9.81
 ARRIVED_M = 1e-3  # closer than this with no speed: snapped onto the target

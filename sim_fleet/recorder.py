@@ -10,7 +10,7 @@ import collections
 from collections.abc import Iterable
 
 from sim_fleet.modes import FlightState
-from sim_fleet.scenario import Vec3
+from sim_fleet.physics import Vec3
 from sim_fleet.vehicle import Vehicle
 
 EVERY_S = 0.5

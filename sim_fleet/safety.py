@@ -21,9 +21,9 @@ import math
 from collections.abc import Iterable
 from dataclasses import dataclass
 
+from proto.site import Safety
 from sim_fleet.modes import FlightState
-from sim_fleet.physics import horizontal_distance
-from sim_fleet.scenario import SafetyRules, Vec3
+from sim_fleet.physics import Vec3, horizontal_distance
 from sim_fleet.vehicle import Vehicle
 
 GROUND_CONTACT = "ground_contact"
@@ -56,7 +56,7 @@ def _pair(a: Vehicle, b: Vehicle, gap_m: float) -> str:
 class SafetyMonitor:
     """Watches state transitions and distances; appends to ``violations``."""
 
-    def __init__(self, rules: SafetyRules, pads: Iterable[Vec3], dock_radius_m: float) -> None:
+    def __init__(self, rules: Safety, pads: Iterable[Vec3], dock_radius_m: float) -> None:
         self.rules = rules
         self.pads = tuple(pads)
         self.dock_radius_m = dock_radius_m

@@ -21,8 +21,7 @@ from collections.abc import Iterable
 from linecrew.bus import Bus
 from proto.keys import KeySpace, UavTopic
 from proto.spots import SpotClaim, StationSpots
-from sim_fleet.physics import horizontal_distance
-from sim_fleet.scenario import Vec3
+from sim_fleet.physics import Vec3, horizontal_distance
 from sim_fleet.vehicle import Vehicle
 from sim_fleet.world import World
 

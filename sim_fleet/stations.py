@@ -10,8 +10,8 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+from proto import site
 from sim_fleet.battery import Battery
-from sim_fleet.scenario import StationSpec
 
 
 @dataclass
@@ -22,9 +22,7 @@ class PadSession:
 
 
 class ChargingStation:
-    def __init__(self, spec: StationSpec) -> None:
-        if spec.recharge is None:
-            raise ValueError(f"station {spec.id} has no recharge model")
+    def __init__(self, spec: site.ChargingStation) -> None:
         self.spec = spec
         self.on_pads: list[PadSession] = []
         self.queue: list[str] = []
@@ -62,19 +60,19 @@ class ChargingStation:
     def step(self, dt_s: float, batteries: dict[str, Battery]) -> list[tuple[str, str]]:
         """Recharge the UAVs on pads for ``dt_s``; returns (vehicle_id, notice) pairs."""
         model = self.spec.recharge
-        assert model is not None
         notices: list[tuple[str, str]] = []
         for s in self.on_pads:
             if s.done:
                 continue
             battery = batteries[s.vehicle_id]
             s.elapsed_s += dt_s
-            if model.kind == "swap":
-                if s.elapsed_s >= model.swap_s:
-                    battery.set_soc(1.0)
+            if isinstance(model, site.BatterySwap):
+                if s.elapsed_s < model.swap_s:
+                    continue
+                battery.set_soc(1.0)
             else:
                 battery.add(battery.capacity_wh * dt_s / model.full_charge_s)
-            if battery.soc >= 1.0 and (model.kind == "charge" or s.elapsed_s >= model.swap_s):
+            if battery.soc >= 1.0:
                 s.done = True
                 notices.append((s.vehicle_id, f"Pad: battery full at {self.id}"))
         return notices

@@ -13,7 +13,7 @@ import math
 from collections.abc import Iterable
 from dataclasses import dataclass
 
-from sim_fleet.scenario import StationSpec, Vec3
+from sim_fleet.physics import Vec3
 
 TERRAIN_Z_M = 0.0
 
@@ -52,8 +52,9 @@ class Deck:
 class Ground:
     """Where the ground is under any point of the site."""
 
-    def __init__(self, stations: Iterable[StationSpec], radius_m: float) -> None:
-        self.decks = tuple(Deck(s.spot_points, radius_m) for s in stations)
+    def __init__(self, spots: Iterable[tuple[Vec3, ...]], radius_m: float) -> None:
+        """``spots``: each station's landing spots."""
+        self.decks = tuple(Deck(points, radius_m) for points in spots)
 
     def z_at(self, x: float, y: float) -> float:
         """The height of the ground (a deck's top, else the terrain) at (x, y)."""

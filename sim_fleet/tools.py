@@ -6,10 +6,12 @@ and benchmarks read them from ``World.deliveries``, never from telemetry.
 
 from __future__ import annotations
 
+from collections.abc import Iterable
 from dataclasses import dataclass
 
-from sim_fleet.physics import horizontal_distance
-from sim_fleet.scenario import InteractionRules, ToolSpec, ToolStationSpec, Vec3
+from proto.site import Tool
+from sim_fleet.physics import Vec3, horizontal_distance
+from sim_fleet.rules import InteractionRules
 
 
 @dataclass(frozen=True, slots=True)
@@ -35,22 +37,18 @@ class Drop:
 
 
 class ToolStation:
-    def __init__(self, spec: ToolStationSpec) -> None:
-        self.spec = spec
-        self.tools: list[ToolSpec] = list(spec.tools)
+    """A pick-up point at ``position``, holding one entry per tool (a
+    ``count`` of 3 is three entries)."""
 
-    @property
-    def id(self) -> str:
-        return self.spec.id
+    def __init__(self, station_id: str, position: Vec3, tools: Iterable[Tool]) -> None:
+        self.id = station_id
+        self.position = position
+        self.tools: list[Tool] = [tool for tool in tools for _ in range(tool.count)]
 
-    @property
-    def position(self) -> Vec3:
-        return self.spec.position
-
-    def take(self) -> ToolSpec | None:
+    def take(self) -> Tool | None:
         return self.tools.pop(0) if self.tools else None
 
-    def put(self, tool: ToolSpec) -> None:
+    def put(self, tool: Tool) -> None:
         self.tools.append(tool)
 
 

@@ -2,14 +2,9 @@
 
 from __future__ import annotations
 
-from proto.geo import Point
 from proto.sim import DeliveryRecord, SafetyViolation, SimState, VehicleTruth, WatchRecord
-from sim_fleet.scenario import Vec3
+from sim_fleet.geo import point
 from sim_fleet.world import World
-
-
-def _point(p: Vec3) -> Point:
-    return Point(x_m=p[0], y_m=p[1], z_m=p[2])
 
 
 def sim_state(world: World, speedup: float) -> SimState:
@@ -20,11 +15,11 @@ def sim_state(world: World, speedup: float) -> SimState:
         vehicles.append(
             VehicleTruth(
                 uav_id=vehicle.id,
-                position=_point(vehicle.position),
+                position=point(vehicle.position),
                 battery_fraction=min(1.0, max(0.0, vehicle.battery.soc)),
                 state=str(vehicle.state.name).lower(),
                 armed=vehicle.armed,
-                tool=vehicle.holding.id if vehicle.holding else None,
+                tool=vehicle.holding.name if vehicle.holding else None,
                 docked_at=docked[0] if docked else None,
             )
         )
@@ -39,7 +34,7 @@ def sim_state(world: World, speedup: float) -> SimState:
             kind=v.kind,
             uav_id=v.vehicle_id,
             sim_time_s=v.time_s,
-            position=_point(v.position),
+            position=point(v.position),
             detail=v.detail,
         )
         for v in world.violations

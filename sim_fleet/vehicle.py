@@ -12,12 +12,14 @@ import math
 from collections.abc import Callable
 from dataclasses import dataclass
 
+from proto.fleet import UavSpec, UavType
+from proto.site import Tool
 from sim_fleet import physics
 from sim_fleet.battery import Battery
 from sim_fleet.events import Severity, StatusText
 from sim_fleet.modes import FlightState, Mode
 from sim_fleet.params import ParamStore, vehicle_parameters
-from sim_fleet.scenario import ToolSpec, Vec3, VehicleSpec, VehicleType
+from sim_fleet.physics import Vec3
 from sim_fleet.terrain import flat
 
 log = logging.getLogger(__name__)
@@ -33,6 +35,8 @@ class AutopilotParams:
 
     rtl_alt_m: float = 15.0  # RTL_ALT
     land_final_alt_m: float = 2.0  # below this LAND descends at land_speed_mps
+    land_speed_mps: float = 0.5  # LAND_SPEED
+    accel_mps2: float = 2.0  # horizontal and vertical acceleration limit
     arm_min_soc: float = 0.25  # pre-arm: below this state of charge arming fails
     low_soc: float = 0.20  # "Battery 1 is low" warning
     critical_soc: float = 0.10  # "Battery 1 is critical" warning
@@ -52,8 +56,8 @@ class AutopilotParams:
 class Vehicle:
     def __init__(
         self,
-        spec: VehicleSpec,
-        vtype: VehicleType,
+        spec: UavSpec,
+        vtype: UavType,
         *,
         sysid: int,
         home: Vec3,
@@ -73,20 +77,20 @@ class Vehicle:
         self.position: Vec3 = self.home
         self.velocity: Vec3 = (0.0, 0.0, 0.0)
         self.heading_deg = 0.0
-        self.battery = Battery(vtype.battery_wh, spec.initial_soc, vtype.cells)
+        self.battery = Battery(vtype.battery_wh)
         self.armed = False
         self.mode = self.params.initial_mode
         self.state = FlightState.LANDED
         self.speed_mps = vtype.cruise_speed_mps
         self.climb_mps = vtype.climb_rate_mps
-        self.descent_mps = vtype.descent_rate_mps
+        self.descent_mps = vtype.climb_rate_mps  # proto has one vertical rate
         self.target: Vec3 | None = None  # position target while flying
         self.velocity_cmd: Vec3 | None = None
         self._velocity_cmd_until = 0.0
         self.rtl_phase: str | None = None  # "climb" | "return" | "descend"
         self._rtl_alt_m = 0.0
         self._land_at: Vec3 = self.home
-        self.holding: ToolSpec | None = None
+        self.holding: Tool | None = None
         self.now_s = 0.0
         self._ground_armed_s = 0.0
         self._warned = 0  # 1: low, 2: critical
@@ -170,7 +174,7 @@ class Vehicle:
             horizontal_mps=self.speed_mps,
             up_mps=self.climb_mps,
             down_mps=down_mps if down_mps is not None else self.descent_mps,
-            accel_mps2=self.type.accel_mps2,
+            accel_mps2=self.params.accel_mps2,
         )
 
     # ---- primitives used by the autopilot rules --------------------------
@@ -270,7 +274,9 @@ class Vehicle:
         if self.state in (FlightState.LANDED, FlightState.CRASHED):
             return
         power_w = (
-            self.type.flight_w if physics.speed(self.velocity) >= MOVING_MPS else self.type.hover_w
+            self.type.flight_power_w
+            if physics.speed(self.velocity) >= MOVING_MPS
+            else self.type.hover_power_w
         )
         self.battery.draw(power_w * self.drain_multiplier, dt_s)
         self._battery_warnings()
@@ -318,7 +324,7 @@ class Vehicle:
     def _descend(self, dt_s: float) -> None:
         ground_z = self.ground_z()
         final = self.position[2] - ground_z <= self.params.land_final_alt_m
-        down = min(self.type.land_speed_mps, self.descent_mps) if final else self.descent_mps
+        down = min(self.params.land_speed_mps, self.descent_mps) if final else self.descent_mps
         self.position, self.velocity = physics.step_to_target(
             self.position, self.velocity, self._land_at, self.limits(down_mps=down), dt_s
         )

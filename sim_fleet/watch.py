@@ -16,7 +16,8 @@ from collections.abc import Iterable
 
 from sim_fleet import physics
 from sim_fleet.modes import FlightState
-from sim_fleet.scenario import InteractionRules, Vec3
+from sim_fleet.physics import Vec3
+from sim_fleet.rules import InteractionRules
 from sim_fleet.vehicle import Vehicle
 
 

@@ -7,7 +7,9 @@ Nothing here reads a clock or sleeps; the runner (``fleet``) or a test decides
 how much time passes. Fault operations are plain methods on the
 world and its vehicles so the later Zenoh fault service only has to call them.
 ``deliveries``, ``drops``, ``violations`` and ``watch`` are the ground truth
-of outcomes.
+of outcomes. The world is built from the shared :class:`proto.scenario.Scenario`
+(its site and fleet; the scripted actions are not the simulator's business),
+whose points become the physics' tuples here.
 """
 
 from __future__ import annotations
@@ -15,13 +17,16 @@ from __future__ import annotations
 import logging
 import math
 
+from proto.scenario import Scenario
+from proto.spots import spot_owners, spot_positions
 from sim_fleet import physics
 from sim_fleet.events import Severity
-from sim_fleet.geo import GeoFrame
+from sim_fleet.geo import GeoFrame, vec
 from sim_fleet.modes import FlightState
+from sim_fleet.physics import Vec3
 from sim_fleet.recorder import FlightRecorder
+from sim_fleet.rules import InteractionRules
 from sim_fleet.safety import SEPARATION, SafetyMonitor, Violation
-from sim_fleet.scenario import Scenario, Vec3
 from sim_fleet.stations import ChargingStation
 from sim_fleet.terrain import Ground
 from sim_fleet.tools import Delivery, Drop, ToolStation, station_in_reach, worker_in_reach
@@ -40,32 +45,41 @@ class World:
         physics_step_s: float = 0.05,
         first_sysid: int = 1,
     ) -> None:
-        self.scenario = scenario
-        self.rules = scenario.rules
-        self.geo = GeoFrame(scenario.origin)
+        site, fleet = scenario.site, scenario.fleet
+        if site.safety.ground_z_m != 0.0:
+            raise ValueError(f"the simulator's ground is at z = 0, not {site.safety.ground_z_m}")
+        self.rules = InteractionRules()
+        self.geo = GeoFrame(site.origin)
         self.physics_step_s = physics_step_s
         self.time_s = 0.0
         self._pending_s = 0.0
-        self.ground = Ground(scenario.stations, self.rules.dock_radius_m)
+        # landing spots by station (proto.spots), and whose home spot each is
+        self.spots: dict[str, tuple[Vec3, ...]] = {
+            s.id: tuple(vec(p) for p in spot_positions(s, fleet)) for s in site.stations
+        }
+        self.spot_owners = {s.id: tuple(spot_owners(s, fleet)) for s in site.stations}
+        self.ground = Ground(self.spots.values(), self.rules.dock_radius_m)
+        types = {t.name: t for t in fleet.types}
         self.vehicles: dict[str, Vehicle] = {}
-        for i, spec in enumerate(scenario.vehicles):
+        for i, spec in enumerate(fleet.uavs):
+            home = self.spot_owners[spec.home_station].index(spec.id)
             self.vehicles[spec.id] = Vehicle(
                 spec,
-                scenario.types[spec.type],
+                types[spec.type],
                 sysid=first_sysid + i,
-                home=scenario.station(spec.home_station).home_spot(spec.id),
+                home=self.spots[spec.home_station][home],
                 params=params,
                 ground=self.ground.z_at,
             )
-        self.charging = {
-            s.id: ChargingStation(s) for s in scenario.stations if s.recharge is not None
+        self.charging = {s.id: ChargingStation(s) for s in site.stations}
+        self.tool_stations = {
+            t.id: ToolStation(t.id, vec(t.position), t.tools) for t in site.tool_stations
         }
-        self.tool_stations = {t.id: ToolStation(t) for t in scenario.tool_stations}
-        self.workers: dict[str, Vec3] = {w.id: w.position for w in scenario.workers}
+        self.workers: dict[str, Vec3] = {w.id: vec(w.position) for w in site.workers}
         self.deliveries: list[Delivery] = []
         self.drops: list[Drop] = []
-        spots = (p for s in scenario.stations for p in s.spot_points)
-        self.safety = SafetyMonitor(scenario.safety, spots, self.rules.dock_radius_m)
+        spots = (p for points in self.spots.values() for p in points)
+        self.safety = SafetyMonitor(site.safety, spots, self.rules.dock_radius_m)
         self.watch = WatchLog(self.rules)
         self.recorder = FlightRecorder()
 
@@ -127,7 +141,7 @@ class World:
                 and not v.armed
                 and any(
                     physics.horizontal_distance(v.position, p) <= dock_r
-                    for p in station.spec.spot_points
+                    for p in self.spots[station.id]
                 )
             ]
             if not docked and not station.on_pads and not station.queue:
@@ -150,7 +164,7 @@ class World:
     def grab(self, vehicle: Vehicle) -> str:
         """Take a tool from the nearest tool station in reach (nothing if it is empty)."""
         if vehicle.holding is not None:
-            return f"Gripper: already holding {vehicle.holding.id}"
+            return f"Gripper: already holding {vehicle.holding.name}"
         landed = vehicle.state is FlightState.LANDED
         hovering = (
             vehicle.state is FlightState.FLYING
@@ -164,8 +178,8 @@ class World:
         if station is None or tool is None:
             return "Gripper: grabbed nothing"
         vehicle.holding = tool
-        log.info("%s grabbed %s at %s", vehicle.id, tool.id, station.id)
-        return f"Gripper: grabbed {tool.id} at {station.id}"
+        log.info("%s grabbed %s at %s", vehicle.id, tool.name, station.id)
+        return f"Gripper: grabbed {tool.name} at {station.id}"
 
     def release(self, vehicle: Vehicle) -> str:
         tool, vehicle.holding = vehicle.holding, None
@@ -174,16 +188,16 @@ class World:
         pos = vehicle.position
         worker = worker_in_reach(pos, self.workers, self.rules)
         if worker is not None:
-            self.deliveries.append(Delivery(tool.id, vehicle.id, worker, self.time_s, pos))
-            log.info("%s delivered %s to %s", vehicle.id, tool.id, worker)
-            return f"Gripper: delivered {tool.id} to {worker}"
+            self.deliveries.append(Delivery(tool.name, vehicle.id, worker, self.time_s, pos))
+            log.info("%s delivered %s to %s", vehicle.id, tool.name, worker)
+            return f"Gripper: delivered {tool.name} to {worker}"
         stations = list(self.tool_stations.values())
         station = station_in_reach(pos, stations, self.rules)
         if station is not None:
             station.put(tool)
         sid = station.id if station is not None else None
-        self.drops.append(Drop(tool.id, vehicle.id, self.time_s, pos, sid))
-        return f"Gripper: returned {tool.id} to {sid}" if sid else f"Gripper: dropped {tool.id}"
+        self.drops.append(Drop(tool.name, vehicle.id, self.time_s, pos, sid))
+        return f"Gripper: returned {tool.name} to {sid}" if sid else f"Gripper: dropped {tool.name}"
 
     # ---- faults -----------------------------------------------------------
     def move_worker(self, worker_id: str, position: Vec3) -> None:

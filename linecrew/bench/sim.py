@@ -15,7 +15,6 @@ import time
 
 from linecrew.scenarios import load, with_fleet_size
 from sim_fleet.fleet import Fleet, FleetConfig, FleetThread
-from sim_fleet.from_proto import scenario_from_proto
 from sim_fleet.streams import TelemetryRates
 
 
@@ -57,7 +56,7 @@ def run(vehicles: int, seconds: float, rate_hz: float, speedup: float) -> dict[s
         rates=TelemetryRates(stream_by_default=True),  # the sink never asks
     )
     scenario = with_fleet_size(load("paper"), vehicles)
-    fleet = Fleet(scenario_from_proto(scenario.site, scenario.fleet), config)
+    fleet = Fleet(scenario, config)
     with FleetThread(fleet):
         time.sleep(1.0)  # warm up: sockets bound, first messages out
         cpu0, wall0, busy0 = time.process_time(), time.monotonic(), fleet.busy_s

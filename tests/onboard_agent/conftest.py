@@ -23,7 +23,6 @@ from proto.scenario import Scenario
 from proto.site import BatterySwap
 from proto.telemetry import AgentStatus, FlightState, TaskOutcome
 from sim_fleet import Fleet, FleetConfig, FleetThread
-from sim_fleet.from_proto import scenario_from_proto
 from sim_fleet.vehicle import AutopilotParams
 from tests.support.processes import running, wait_until
 
@@ -49,9 +48,8 @@ def start_fleet(scenario: Scenario | None = None, **config) -> FleetThread:
     every vehicle on a free port; ``config``: FleetConfig fields."""
     scenario = scenario or fast_scenario()
     config = {"params": AutopilotParams(auto_disarm_s=30.0)} | config
-    world = scenario_from_proto(scenario.site, scenario.fleet)
     return FleetThread(
-        Fleet(world, FleetConfig(speedup=SPEEDUP, rate_hz=50.0, base_port=0, **config))
+        Fleet(scenario, FleetConfig(speedup=SPEEDUP, rate_hz=50.0, base_port=0, **config))
     ).start()
 
 

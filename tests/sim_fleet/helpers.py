@@ -4,94 +4,72 @@ from __future__ import annotations
 
 from collections.abc import Callable
 
-from sim_fleet import (
-    GeoOrigin,
-    InteractionRules,
-    RechargeModel,
-    Scenario,
-    StationSpec,
-    ToolSpec,
-    ToolStationSpec,
-    VehicleSpec,
-    VehicleType,
-    WorkerSpec,
-    World,
-)
+import msgspec
+
+from proto.fleet import Fleet, UavSpec, UavType
+from proto.geo import GeoPoint, Point
+from proto.scenario import Scenario
+from proto.site import BatterySwap, Charging, ChargingStation, Site, Tool, ToolStation, Worker
+from sim_fleet import World
 from sim_fleet import autopilot as ap
 from sim_fleet.autopilot import Command
 from sim_fleet.events import Outcome
 from sim_fleet.modes import Mode
 from sim_fleet.vehicle import AutopilotParams, Vehicle
 
-QUAD = VehicleType(
+QUAD = UavType(
     name="quad",
-    capabilities=frozenset(),
+    capabilities={},
     cruise_speed_mps=5.0,
     climb_rate_mps=2.0,
-    descent_rate_mps=1.5,
-    accel_mps2=3.0,
     battery_wh=100.0,
-    flight_w=360.0,
-    hover_w=300.0,
+    flight_power_w=360.0,
+    hover_power_w=300.0,
 )
-CARRIER = VehicleType(
-    name="carrier",
-    capabilities=frozenset(),
-    cruise_speed_mps=5.0,
-    climb_rate_mps=2.0,
-    descent_rate_mps=1.5,
-    battery_wh=100.0,
-    flight_w=360.0,
-    hover_w=300.0,
-    gripper=True,
-)
+CARRIER = msgspec.structs.replace(QUAD, name="carrier", gripper=True)
+
+
+def station(station_id: str, x: float, y: float, z: float = 0.0, **kw) -> ChargingStation:
+    """A charging station at (x, y, z); ``kw``: pads, recharge."""
+    return ChargingStation(id=station_id, position=Point(x_m=x, y_m=y, z_m=z), **kw)
 
 
 def scenario(
     *,
     n: int = 1,
-    vtype: VehicleType = QUAD,
-    stations: tuple[StationSpec, ...] | None = None,
+    vtype: UavType = QUAD,
+    stations: tuple[ChargingStation, ...] | None = None,
     homes: tuple[str, ...] | None = None,
-    soc: float = 1.0,
 ) -> Scenario:
     stations = stations or (
-        StationSpec(
-            id="S1",
-            position=(0.0, 0.0, 0.0),
-            pads=1,
-            recharge=RechargeModel(kind="charge", full_charge_s=1000.0),
-        ),
-        StationSpec(
-            id="S2",
-            position=(100.0, 0.0, 0.0),
-            pads=1,
-            recharge=RechargeModel(kind="swap", swap_s=30.0),
-        ),
-        StationSpec(id="L1", position=(0.0, 50.0, 0.0)),
+        station("S1", 0.0, 0.0, recharge=Charging(full_charge_s=1000.0)),
+        station("S2", 100.0, 0.0, recharge=BatterySwap(swap_s=30.0)),
+        station("L1", -2.0, 50.0),  # its pad; u1's home spot is (0, 50, 0), u2's (2, 50, 0)...
     )
     homes = homes or tuple("L1" for _ in range(n))
-    return Scenario(
-        origin=GeoOrigin(lat_deg=37.41, lon_deg=-6.0, alt_m=10.0),
-        types={vtype.name: vtype},
-        vehicles=tuple(
-            VehicleSpec(id=f"u{i + 1}", type=vtype.name, home_station=homes[i], initial_soc=soc)
-            for i in range(n)
-        ),
-        stations=stations,
-        tool_stations=(
-            ToolStationSpec(
-                id="T1", position=(20.0, 0.0, 3.0), tools=(ToolSpec(id="hammer", mass_kg=1.5),)
-            ),
-        ),
-        workers=(WorkerSpec(id="W1", position=(40.0, 0.0, 3.0)),),
-        rules=InteractionRules(),
+    site = Site(
+        origin=GeoPoint(lat_deg=37.41, lon_deg=-6.0, alt_m=10.0),
+        stations=list(stations),
+        tool_stations=[
+            ToolStation(
+                id="T1",
+                position=Point(x_m=20.0, y_m=0.0, z_m=3.0),
+                tools=[Tool(name="hammer", mass_kg=1.5)],
+            )
+        ],
+        workers=[Worker(id="W1", position=Point(x_m=40.0, y_m=0.0, z_m=3.0))],
     )
+    uavs = [UavSpec(id=f"u{i + 1}", type=vtype.name, home_station=homes[i]) for i in range(n)]
+    return Scenario(name="test", site=site, fleet=Fleet(types=[vtype], uavs=uavs))
 
 
-def world(**kw) -> World:
+def world(*, soc: float = 1.0, **kw) -> World:
+    """A world of :func:`scenario` (``kw``), every battery at ``soc``."""
     params = kw.pop("params", AutopilotParams(auto_disarm_s=None, warmup_s=0.0))
-    return World(scenario(**kw), params=params)
+    w = World(scenario(**kw), params=params)
+    for v in w.vehicles.values():
+        v.set_battery_soc(soc)
+    return w
 
 
 def command(w: World, v: Vehicle, cmd: int, *params: float, frame: int | None = None) -> Outcome:

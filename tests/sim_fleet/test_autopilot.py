@@ -83,7 +83,7 @@ def test_change_speed(wv):
     assert command(w, v, SPEED, 7, 3).result is Result.DENIED  # no such speed type
     assert command(w, v, SPEED, 1, 3).result is Result.ACCEPTED and v.speed_mps == 3
     assert command(w, v, SPEED, 1, 99).result is Result.ACCEPTED
-    assert v.speed_mps == v.type.speed_cap_mps
+    assert v.speed_mps == 2 * v.type.cruise_speed_mps  # the cap
     assert command(w, v, SPEED, 2, 1).result is Result.ACCEPTED and v.climb_mps == 1
     assert command(w, v, SPEED, 3, 0.5).result is Result.ACCEPTED and v.descent_mps == 0.5
     command(w, v, MODE, 1, Mode.LAND)

@@ -18,7 +18,6 @@ from proto import (
 )
 from proto.site import TimedPoint, Worker
 from sim_fleet.faults import OutsideSite, UnknownTarget, apply_fault
-from sim_fleet.from_proto import scenario_from_proto
 from sim_fleet.truth import sim_state
 from sim_fleet.workers import worker_position
 from sim_fleet.world import World
@@ -28,7 +27,7 @@ PAPER = load("paper")
 
 @pytest.fixture
 def world():
-    return World(scenario_from_proto(PAPER.site, PAPER.fleet))
+    return World(PAPER)
 
 
 def test_battery_fault_sets_the_charge(world):

@@ -22,7 +22,7 @@ def test_drain_multiplier_scales_energy():
     v.drain_multiplier = 3.0
     before = v.battery.energy_wh
     w.step(60.0)
-    assert before - v.battery.energy_wh == pytest.approx(3.0 * v.type.hover_w * 60.0 / 3600.0)
+    assert before - v.battery.energy_wh == pytest.approx(3.0 * v.type.hover_power_w * 60.0 / 3600.0)
 
 
 def test_motor_failure_falls_and_crashes():

@@ -158,10 +158,12 @@ def test_local_ned_flight_grab_and_deliver_a_tool(fleet, client):
     client.command(mavlink.MAV_CMD_NAV_TAKEOFF, 0, 0, 0, 0, 0, 0, 4)
     client.wait("GLOBAL_POSITION_INT", lambda m: m.relative_alt > 3900, timeout_s=20)
 
-    def local_goto(east, north, up):  # uav1's home (EKF origin) is C1 at (-10, 10)
+    ox, oy, _ = fleet.call(lambda: world.vehicle("uav1").origin)  # its home spot at C1
+
+    def local_goto(east, north, up):  # LOCAL_NED is about the EKF origin
         client.conn.mav.set_position_target_local_ned_send(
             0, 1, 1, mavlink.MAV_FRAME_LOCAL_NED, 0b110111111000,
-            north - 10.0, east + 10.0, -up, 0, 0, 0, 0, 0, 0, 0, 0,
+            north - oy, east - ox, -up, 0, 0, 0, 0, 0, 0, 0, 0,
         )  # fmt: skip
         lat, lon, _ = fleet.call(lambda: world.geo.to_geodetic((east, north, 0.0)))
 

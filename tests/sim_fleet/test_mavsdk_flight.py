@@ -220,7 +220,7 @@ def test_gripper_needs_grip_enable_then_grabs_and_delivers(fleet):
         return {"held": held}
 
     seen = fly(port, script)
-    assert seen["held"] is not None and seen["held"].id == "hammer"
+    assert seen["held"] is not None and seen["held"].name == "hammer"
     [delivery] = fleet.call(lambda: list(world.deliveries))
     assert (delivery.tool_id, delivery.worker_id) == ("hammer", "W1")
 

@@ -18,7 +18,7 @@ REL = mavlink.MAV_FRAME_GLOBAL_RELATIVE_ALT_INT
 AMSL = mavlink.MAV_FRAME_GLOBAL_INT
 WP, LOITER_TIME, RTL, LAND, TAKEOFF = 16, 19, 20, 21, 22
 CHANGE_SPEED, GRIPPER = 178, 211
-HOME_C1 = (-10.0, 10.0, 0.0)  # uav1's pad
+HOME_C1 = (-8.0, 10.0, 0.0)  # uav1's home spot, beside C1's pad (proto.spots)
 ARMED = mavlink.MAV_MODE_FLAG_SAFETY_ARMED
 
 

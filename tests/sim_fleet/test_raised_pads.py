@@ -6,15 +6,16 @@ from __future__ import annotations
 
 import pytest
 
-from sim_fleet import Fleet, FleetConfig, FleetThread, StationSpec
+from sim_fleet import Fleet, FleetConfig, FleetThread
 from sim_fleet import autopilot as ap
 from sim_fleet.modes import FlightState
 from sim_fleet.vehicle import AutopilotParams
-from tests.sim_fleet.helpers import airborne, command, run_until, scenario, world
+from tests.sim_fleet.helpers import airborne, command, run_until, scenario, station, world
 from tests.sim_fleet.mavclient import Client, mavlink
 
-ROOF = StationSpec(id="ROOF", position=(0.0, 0.0, 6.0), spots=((0.0, 0.0, 6.0), (2.0, 0.0, 6.0)))
-YARD = StationSpec(id="YARD", position=(30.0, 0.0, 0.0))
+# one pad at (0, 0, 6); based there, u1's home spot is beside it at (2, 0, 6) (proto.spots)
+ROOF = station("ROOF", 0.0, 0.0, 6.0)
+YARD = station("YARD", 30.0, 0.0)
 STATIONS = (ROOF, YARD)
 
 
@@ -41,13 +42,13 @@ def test_the_ground_is_a_decks_top_over_it_and_the_terrain_elsewhere():
 
 def test_a_vehicle_rests_on_its_roof_pad_and_takes_off_above_home():
     w, v = site("ROOF")
-    assert v.position == v.home == (0.0, 0.0, 6.0)
+    assert v.position == v.home == (2.0, 0.0, 6.0)
     assert command(w, v, 176, 1, 4).result == 0
     assert command(w, v, 400, 1).result == 0
     assert command(w, v, ap.CMD_NAV_TAKEOFF, 0, 0, 0, 0, 0, 0, 0.0).result == ap.Result.FAILED
     assert command(w, v, ap.CMD_NAV_TAKEOFF, 0, 0, 0, 0, 0, 0, 4.0).result == 0
     run_until(w, lambda: v.state is FlightState.FLYING)
-    assert v.position == (0.0, 0.0, 10.0)
+    assert v.position == (2.0, 0.0, 10.0)
 
 
 def test_below_a_roofs_top_away_from_it_is_flying_and_the_terrain_is_a_crash():
@@ -71,14 +72,14 @@ def test_flying_into_a_raised_deck_below_its_top_is_a_crash():
 def test_landing_onto_a_roof_pad_is_no_crash_and_landing_beside_it_reaches_the_terrain():
     w, v = site("YARD")
     airborne(w, v, 4.0)
-    goto(w, v, (2.0, 0.0, 9.0))
+    goto(w, v, (0.0, 0.0, 9.0))
     land(w, v)
-    assert v.state is FlightState.LANDED and v.position == (2.0, 0.0, 6.0)
+    assert v.state is FlightState.LANDED and v.position == (0.0, 0.0, 6.0)
     assert not v.armed and w.violations == []
     airborne(w, v, 3.0)
-    goto(w, v, (2.0, 4.0, 9.0))
+    goto(w, v, (0.0, 4.0, 9.0))
     land(w, v)
-    assert v.state is FlightState.LANDED and v.position == (2.0, 4.0, 0.0)
+    assert v.state is FlightState.LANDED and v.position == (0.0, 4.0, 0.0)
     assert [x.kind for x in w.violations] == ["off_pad_landing"]
 
 
@@ -96,12 +97,12 @@ def test_rtl_climbs_above_home_and_lands_back_on_the_roof():
     assert command(w, v, ap.CMD_NAV_RETURN_TO_LAUNCH).result == 0
     run_until(w, landed)
     assert peak == pytest.approx(6.0 + v.params.rtl_alt_m, abs=0.05)
-    assert v.position == pytest.approx((0.0, 0.0, 6.0)) and w.violations == []
+    assert v.position == pytest.approx((2.0, 0.0, 6.0)) and w.violations == []
 
 
 def test_mavlink_altitudes_are_amsl_and_above_home_and_absolute_targets_are_honoured():
     sc = scenario(stations=STATIONS, homes=("ROOF",))
-    origin_mm = round(sc.origin.alt_m * 1000)
+    origin_mm = round(sc.site.origin.alt_m * 1000)
     config = FleetConfig(
         speedup=10.0, rate_hz=50.0, base_port=0, params=AutopilotParams(warmup_s=0.0)
     )

@@ -2,16 +2,17 @@
 
 from __future__ import annotations
 
-import dataclasses
 import itertools
 import logging
 import math
 import random
 import re
 
+import msgspec
+
 import proto
 from proto.codec import decode, encode
-from sim_fleet import SafetyRules, World
+from sim_fleet import World
 from sim_fleet import autopilot as ap
 from sim_fleet.modes import FlightState
 from sim_fleet.safety import SafetyMonitor
@@ -41,7 +42,7 @@ def test_guided_target_below_the_ground_is_a_crash_and_ground_contact():
     v.take_texts()
     ap.position_target(v, (3.0, 50.0, -4.0), None)  # clamped to z = 0
     assert v.target == (3.0, 50.0, 0.0)
-    run_until(w, lambda: v.state is not FlightState.FLYING, max_s=30.0)
+    run_until(w, lambda: v.state is not FlightState.FLYING, max_s=30.0, dt=w.physics_step_s)
     assert v.state is FlightState.CRASHED and not v.armed and v.position[2] == 0.0
     assert "Crash: Disarming" in [t.text for t in v.take_texts()]
     [violation] = w.violations
@@ -121,7 +122,8 @@ def test_separation_recorded_once_under_the_lower_id():
     u1, u2, u3 = (w.vehicle(f"u{i}") for i in (1, 2, 3))
     airborne(w, u1, 10.0)
     airborne(w, u2, 10.0)
-    goto(w, u2, (0.6, 0.0, 10.0))  # u2 comes to u1 (S1 at the origin)
+    x = u1.home[0]  # u1's home spot at S1
+    goto(w, u2, (x + 0.6, 0.0, 10.0))  # u2 comes to u1
     w.step(10.0)
     assert kinds(w) == [("separation", "u1", "u2")]
     # where both were and what they did: a chaos report must be diagnosable
@@ -129,8 +131,8 @@ def test_separation_recorded_once_under_the_lower_id():
         r"u2 0\.\d\d m apart: u1 flying \w+ at \(.+\), u2 flying \w+ at \(.+\)",
         w.violations[0].detail,
     ), w.violations[0].detail
-    goto(w, u2, (0.0, 0.0, 11.5))  # 1.5 m: clear again
-    goto(w, u2, (0.0, 0.3, 10.5))
+    goto(w, u2, (x, 0.0, 11.5))  # 1.5 m: clear again
+    goto(w, u2, (x, 0.3, 10.5))
     assert kinds(w) == [("separation", "u1", "u2")] * 2
     # u3 landed at L1: coming down to 0.8 m above it is a near collision too
     goto(w, u1, (0.0, 50.0, 3.0))
@@ -170,11 +172,9 @@ def test_a_crash_is_logged_with_how_the_vehicle_got_there(caplog):
 
 def test_safety_distances_come_from_the_scenario():
     sc = scenario(n=2, homes=("S1", "S2"))
-    assert sc.safety == SafetyRules()  # defaults as proto.Safety
-    assert SafetyRules().people_clearance_m == proto.Safety().people_clearance_m
-    assert SafetyRules().separation_m == proto.Safety().separation_m
-    rules = SafetyRules(people_clearance_m=3.0, separation_m=5.0)
-    w = World(dataclasses.replace(sc, safety=rules), params=AutopilotParams(warmup_s=0.0))
+    rules = proto.Safety(people_clearance_m=3.0, separation_m=5.0)
+    site = msgspec.structs.replace(sc.site, safety=rules)
+    w = World(msgspec.structs.replace(sc, site=site), params=AutopilotParams(warmup_s=0.0))
     u1, u2 = w.vehicle("u1"), w.vehicle("u2")
     airborne(w, u1, 10.0)
     airborne(w, u2, 10.0)
@@ -188,7 +188,7 @@ def test_sim_state_reports_violations_as_proto_records():
     v = w.vehicle("u1")
     airborne(w, v, 5.0)
     ap.position_target(v, (0.0, 50.0, 0.0), None)
-    run_until(w, lambda: v.state is FlightState.CRASHED, max_s=30.0)
+    run_until(w, lambda: v.state is FlightState.CRASHED, max_s=30.0, dt=w.physics_step_s)
     state = sim_state(w, 1.0)
     [violation] = state.violations
     assert isinstance(violation, proto.SafetyViolation)
@@ -202,7 +202,8 @@ def test_pairwise_sweep_finds_exactly_the_close_pairs():
     rng = random.Random(7)
     sc = scenario(n=60)
     vehicles = [
-        Vehicle(spec, QUAD, sysid=i + 1, home=(0.0, 0.0, 0.0)) for i, spec in enumerate(sc.vehicles)
+        Vehicle(spec, QUAD, sysid=i + 1, home=(0.0, 0.0, 0.0))
+        for i, spec in enumerate(sc.fleet.uavs)
     ]
     for v in vehicles:
         v.state = FlightState.FLYING
@@ -210,7 +211,7 @@ def test_pairwise_sweep_finds_exactly_the_close_pairs():
     landed = {vehicles[0].id, vehicles[1].id}  # two on the ground: never a pair
     vehicles[0].state = vehicles[1].state = FlightState.LANDED
     vehicles[1].position = (vehicles[0].position[0] + 0.5, *vehicles[0].position[1:])
-    monitor = SafetyMonitor(SafetyRules(separation_m=1.0), [], 1.0)
+    monitor = SafetyMonitor(proto.Safety(separation_m=1.0), [], 1.0)
     monitor.check(vehicles, {}, 0.0)
     found = {(v.vehicle_id, _other(v)) for v in monitor.violations}
     want = {

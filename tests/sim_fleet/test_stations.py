@@ -4,10 +4,10 @@ from __future__ import annotations
 
 import pytest
 
-from sim_fleet import RechargeModel, StationSpec
+from proto.site import BatterySwap
 from sim_fleet import autopilot as ap
 from sim_fleet.modes import FlightState
-from tests.sim_fleet.helpers import airborne, command, run_until, world
+from tests.sim_fleet.helpers import airborne, command, run_until, station, world
 
 CHARGE_S = 1000.0
 SWAP_S = 30.0
@@ -50,13 +50,8 @@ def test_landing_on_a_pad_recharges():
 
 def test_more_vehicles_than_pads_queue_in_arrival_order():
     stations = (
-        StationSpec(
-            id="P",
-            position=(0.0, 0.0, 0.0),
-            pads=2,
-            recharge=RechargeModel(kind="swap", swap_s=SWAP_S),
-        ),
-        StationSpec(id="L1", position=(0.0, 50.0, 0.0)),
+        station("P", 0.0, 0.0, pads=2, recharge=BatterySwap(swap_s=SWAP_S)),
+        station("L1", 0.0, 50.0),
     )
     w = world(n=3, stations=stations, homes=("P", "P", "P"), soc=0.5)
     w.step(0.1)

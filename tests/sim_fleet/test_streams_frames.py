@@ -2,9 +2,9 @@ from __future__ import annotations
 
 import pytest
 
+from proto.geo import GeoPoint
 from sim_fleet import frames, streams
 from sim_fleet.geo import GeoFrame
-from sim_fleet.scenario import GeoOrigin
 
 
 def test_only_the_heartbeat_streams_until_asked_like_arducopter_with_sr_rates_at_0():
@@ -47,7 +47,7 @@ def test_coarse_ticks_send_once_per_tick_without_bursts():
     assert counts == [1, 1, 1, 1, 1]
 
 
-GEO = GeoFrame(GeoOrigin(lat_deg=37.41, lon_deg=-6.0, alt_m=10.0))
+GEO = GeoFrame(GeoPoint(lat_deg=37.41, lon_deg=-6.0, alt_m=10.0))
 
 
 def test_global_frames_round_trip():

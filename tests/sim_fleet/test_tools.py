@@ -25,7 +25,7 @@ def test_hover_low_at_tool_station_grab_then_deliver_to_worker():
     airborne(w, v, 5.0)
     goto(w, v, (20.0, 0.0, 4.5))  # T1 holds the hammer at (20, 0, 3)
     assert command(w, v, GRIPPER, 1, GRAB).result is Result.ACCEPTED
-    assert v.holding is not None and v.holding.id == "hammer"
+    assert v.holding is not None and v.holding.name == "hammer"
     assert w.tool_stations["T1"].tools == []
     goto(w, v, (41.0, 0.0, 5.0))  # W1 at (40, 0, 3)
     assert command(w, v, GRIPPER, 1, RELEASE).result is Result.ACCEPTED
@@ -89,7 +89,7 @@ def test_grab_takes_only_from_the_nearest_station_even_when_it_is_empty():
     airborne(w, v, 4.5)
     goto(w, v, (1.2, 5.0, 4.5))
     command(w, v, GRIPPER, 1, GRAB)
-    assert v.holding is not None and v.holding.id == "wrench"
+    assert v.holding is not None and v.holding.name == "wrench"
     goto(w, v, (0.0, 11.0, 5.0))
     command(w, v, GRIPPER, 1, RELEASE)
     assert [d.tool_id for d in w.deliveries] == ["wrench"]
@@ -98,7 +98,7 @@ def test_grab_takes_only_from_the_nearest_station_even_when_it_is_empty():
     command(w, v, GRIPPER, 1, GRAB)
     assert v.holding is None
     assert [t.text for t in v.take_texts()] == ["Gripper: grabbed nothing"]
-    assert [t.id for t in w.tool_stations["P-allen_wrench"].tools] == ["allen_wrench"]
+    assert [t.name for t in w.tool_stations["P-allen_wrench"].tools] == ["allen_wrench"]
     goto(w, v, (1.8, 5.0, 4.5))  # nearer the allen wrench now
     command(w, v, GRIPPER, 1, GRAB)
-    assert v.holding is not None and v.holding.id == "allen_wrench"
+    assert v.holding is not None and v.holding.name == "allen_wrench"

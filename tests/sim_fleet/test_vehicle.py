@@ -35,7 +35,7 @@ def test_hover_energy_is_hover_power_times_time():
     airborne(w, v, 10.0)
     before = v.battery.energy_wh
     w.step(120.0)
-    assert before - v.battery.energy_wh == pytest.approx(QUAD.hover_w * 120.0 / 3600.0)
+    assert before - v.battery.energy_wh == pytest.approx(QUAD.hover_power_w * 120.0 / 3600.0)
 
 
 def test_cruise_energy_is_flight_power_times_time():
@@ -46,7 +46,7 @@ def test_cruise_energy_is_flight_power_times_time():
     run_until(w, lambda: v.velocity[1] == pytest.approx(QUAD.cruise_speed_mps))
     before = v.battery.energy_wh
     w.step(60.0)  # still cruising: 500 m at 5 m/s is 100 s
-    assert before - v.battery.energy_wh == pytest.approx(QUAD.flight_w * 60.0 / 3600.0)
+    assert before - v.battery.energy_wh == pytest.approx(QUAD.flight_power_w * 60.0 / 3600.0)
 
 
 def test_land_mode_descends_lands_and_disarms():

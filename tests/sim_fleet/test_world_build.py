@@ -1,10 +1,15 @@
+"""A world built from a shared proto scenario: spots, homes, types, safety, tools."""
+
 from __future__ import annotations
 
 import pytest
 
 import proto
-from sim_fleet import SafetyRules, World
-from sim_fleet.from_proto import scenario_from_proto
+from sim_fleet import World
+
+
+def _scenario(site: proto.Site, fleet: proto.Fleet) -> proto.Scenario:
+    return proto.Scenario(name="t", site=site, fleet=fleet)
 
 
 def test_proto_site_and_fleet_become_a_world():
@@ -42,17 +47,16 @@ def test_proto_site_and_fleet_become_a_world():
         ],
         uavs=[proto.UavSpec(id="uav1", type="carrier", home_station="C1")],
     )
-    sc = scenario_from_proto(site, fleet)
-    assert sc.site == "s1" and sc.origin.alt_m == 5.0
-    assert sc.station("C1").recharge.kind == "swap" and sc.station("C1").recharge.swap_s == 42.0
-    assert sc.station("C2").recharge.kind == "charge"
-    w = World(sc)
+    w = World(_scenario(site, fleet))
     v = w.vehicle("uav1")
     # one spot per pad about the station, uav1's home spot on along the row, 2 m apart
-    assert sc.station("C1").spots == ((4.0, 2.0, 0.0), (0.0, 2.0, 0.0), (2.0, 2.0, 0.0))
-    assert sc.station("C1").owners == ("uav1", None, None)
+    assert w.spots["C1"] == ((4.0, 2.0, 0.0), (0.0, 2.0, 0.0), (2.0, 2.0, 0.0))
+    assert w.spot_owners["C1"] == ("uav1", None, None)
     assert v.home == (4.0, 2.0, 0.0) and v.has_gripper and v.battery.capacity_wh == 80.0
-    assert w.tool_stations["T1"].tools[0].id == "hammer"
+    assert v.descent_mps == v.climb_mps  # proto has one vertical rate
+    assert w.workers == {"W1": (0.0, 10.0, 3.0)}
+    assert w.tool_stations["T1"].position == (3.0, 3.0, 3.0)
+    assert w.tool_stations["T1"].tools[0].name == "hammer"
 
 
 def _site(**kw) -> proto.Site:
@@ -69,22 +73,16 @@ _FLEET = proto.Fleet(
 )
 
 
-def test_site_safety_distances_reach_the_simulator():
-    safety = proto.Safety(people_clearance_m=4.0, separation_m=2.5, min_altitude_m=3.0)
-    sc = scenario_from_proto(_site(safety=safety), _FLEET)
-    assert sc.safety == SafetyRules(people_clearance_m=4.0, separation_m=2.5)
-    default = scenario_from_proto(_site(), _FLEET).safety
-    assert default.people_clearance_m == proto.Safety().people_clearance_m
-    assert default.separation_m == proto.Safety().separation_m
+def test_the_simulators_ground_is_at_zero():
     with pytest.raises(ValueError, match="ground"):
-        scenario_from_proto(_site(safety=proto.Safety(ground_z_m=5.0)), _FLEET)
+        World(_scenario(_site(safety=proto.Safety(ground_z_m=5.0)), _FLEET))
 
 
 def test_tool_count_gives_the_station_that_many_copies():
     tools = [proto.Tool(name="hammer", mass_kg=1.5, count=3), proto.Tool(name="pliers")]
     station = proto.ToolStation(id="T1", position=proto.Point(x_m=3.0, y_m=3.0), tools=tools)
-    w = World(scenario_from_proto(_site(tool_stations=[station]), _FLEET))
-    held = [t.id for t in w.tool_stations["T1"].tools]
+    w = World(_scenario(_site(tool_stations=[station]), _FLEET))
+    held = [t.name for t in w.tool_stations["T1"].tools]
     assert held == ["hammer"] * 3 + ["pliers"]
     assert held.count("hammer") == station.stock("hammer")
     assert w.tool_stations["T1"].tools[0].mass_kg == 1.5
