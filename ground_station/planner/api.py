@@ -4,30 +4,40 @@ from __future__ import annotations
 
 import dataclasses
 from collections.abc import Callable
+from typing import NamedTuple
 
 from msgspec.structs import replace
 
 from ground_station.planner.errors import PlanningProblemError
 from ground_station.planner.export import export
 from ground_station.planner.heuristic import build
-from ground_station.planner.improve import improve
+from ground_station.planner.improve import Score, improve
 from ground_station.planner.load import check_problem
 from ground_station.planner.model import CostWeights, Problem
 from ground_station.planner.result import Plan
-from ground_station.planner.routes import Options
+from ground_station.planner.routes import Ctx, Options
 
-VARIANTS: tuple[tuple[float, float, int, float], ...] = (
-    (0.5, 0.0, 3, 1.0),
-    (1.0, 0.3, 6, 1.6),
-    (0.5, 0.3, 6, 0.4),
-    (1.0, 0.0, 6, 1.0),
-    (0.5, 1.0, 3, 1.6),
-    (2.5, 0.3, 6, 1.0),
-    (1.0, 1.0, 3, 0.4),
-    (0.5, 0.0, 6, 1.6),
+
+class Variant(NamedTuple):
+    """A differently tuned construction: factors on the suitability and
+    approach weights, and ``Options.resource_factor`` and ``max_eval``."""
+
+    suitability_factor: float
+    resource_factor: float
+    max_eval: int
+    approach_factor: float
+
+
+VARIANTS: tuple[Variant, ...] = (
+    Variant(0.5, 0.0, 3, 1.0),
+    Variant(1.0, 0.3, 6, 1.6),
+    Variant(0.5, 0.3, 6, 0.4),
+    Variant(1.0, 0.0, 6, 1.0),
+    Variant(0.5, 1.0, 3, 1.6),
+    Variant(2.5, 0.3, 6, 1.0),
+    Variant(1.0, 1.0, 3, 0.4),
+    Variant(0.5, 0.0, 6, 1.6),
 )
-"""Per variant: factors on the suitability and approach weights, the
-resource factor and max evaluations."""
 RUN_ROUNDS = 600
 """Time-bounded improvement: rounds per independent run. Runs restart from
 a construction with new seeds and the best is kept: one run's result
@@ -43,12 +53,12 @@ RESTART_WORK = 3000
 small instances, none from about 20 UAVs x 150 actions up)."""
 
 
-def score(p: Plan) -> tuple[int, float]:
+def score(p: Plan) -> Score:
     """What improvement minimises: (unplaced parts, weight-averaged completion
     time + makespan), both in seconds from ``now_s`` and of similar size, so
     neither the priority-weighted service nor the end of the mission is
     sacrificed to the other."""
-    return len(p.unplaced), p.metrics.mean_completion_s + p.metrics.makespan_s
+    return Score(len(p.unplaced), p.metrics.mean_completion_s + p.metrics.makespan_s)
 
 
 def variants(options: Options, weights: CostWeights) -> list[Options]:
@@ -56,11 +66,17 @@ def variants(options: Options, weights: CostWeights) -> list[Options]:
     greedy is sensitive to its knobs, so a few differently tuned runs often
     find a much better start than local search alone."""
     out = []
-    for w1, rf, me, wa in VARIANTS:
+    for v in VARIANTS:
         w = replace(
-            weights, suitability_s=weights.suitability_s * w1, approach=weights.approach * wa
+            weights,
+            suitability_s=weights.suitability_s * v.suitability_factor,
+            approach=weights.approach * v.approach_factor,
         )
-        out.append(dataclasses.replace(options, weights=w, resource_factor=rf, max_eval=me))
+        out.append(
+            dataclasses.replace(
+                options, weights=w, resource_factor=v.resource_factor, max_eval=v.max_eval
+            )
+        )
     return out
 
 
@@ -94,9 +110,41 @@ def plan(
     if should_stop is None and max_rounds <= 0:
         return export(ctx)
     stop = should_stop or (lambda: False)
+    starts, best = _starts(problem, options, ctx, stop, max_rounds)
+    if max_rounds > 0:
+        ctx = starts[0].ctx
+        improve(ctx, stop, max_rounds, seed)
+        out = export(ctx)
+        return out if score(out) <= score(best) else best
+    tops = [(s.ctx, s.ctx.snapshot()) for s in starts[:START_COUNT]]
+    run = 0
+    while not stop():  # independent runs from the best starts in turn
+        ctx, snap = tops[run % len(tops)]
+        ctx.restore(snap)
+        improve(ctx, stop, RUN_ROUNDS, seed + run)
+        run += 1
+        out = export(ctx)
+        if score(out) < score(best):
+            best = out
+    return best
+
+
+class _Start(NamedTuple):
+    """A construction improvement may start from, and its plan's score."""
+
+    score: Score
+    ctx: Ctx
+
+
+def _starts(
+    problem: Problem, options: Options, ctx: Ctx, stop: Callable[[], bool], max_rounds: int
+) -> tuple[list[_Start], Plan]:
+    """The constructions to improve, best first (``ctx``, the complete
+    heuristic's, wins ties), and the best plan among them; unless ``options``
+    is paper mode, the paper heuristic's too and, time-bounded, the
+    ``variants`` (as many as ``stop`` lets build)."""
     best = export(ctx)
-    floor = best
-    starts = [(score(best), ctx)]
+    starts = [_Start(score(best), ctx)]
     if options.mode != "paper":
         others = [Options(mode="paper", max_split=options.max_split)]
         if max_rounds <= 0:  # time-bounded: also try other tunings
@@ -111,25 +159,8 @@ def plan(
             other_ctx = build(problem, opt)
             other = export(other_ctx)
             other_ctx.options = options
-            if i == 0 and score(other) < score(floor):
-                floor = other
-            starts.append((score(other), other_ctx))
+            starts.append(_Start(score(other), other_ctx))
             if score(other) < score(best):
                 best = other
-    starts.sort(key=lambda x: x[0])  # stable: the complete heuristic wins ties
-    if max_rounds > 0:
-        ctx = starts[0][1]
-        improve(ctx, stop, max_rounds, seed)
-        out = export(ctx)
-        return out if score(out) <= score(best) else best
-    tops = [(c, c.snapshot()) for _, c in starts[:START_COUNT]]
-    run = 0
-    while not stop():  # independent runs from the best starts in turn
-        ctx, snap = tops[run % len(tops)]
-        ctx.restore(snap)
-        improve(ctx, stop, RUN_ROUNDS, seed + run)
-        run += 1
-        out = export(ctx)
-        if score(out) < score(best):
-            best = out
-    return best
+    starts.sort(key=lambda s: s.score)  # stable: the complete heuristic wins ties
+    return starts, best

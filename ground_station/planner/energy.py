@@ -10,6 +10,8 @@ from __future__ import annotations
 from math import dist
 from operator import add
 
+import msgspec
+
 from ground_station.planner.holds import HoldPoints
 from ground_station.planner.model import Problem, Station, Uav, UavType, Vec3
 
@@ -61,6 +63,13 @@ def energy_after_recharge(
     return min(capacity_wh, energy_wh + capacity_wh * duration_s / station.full_charge_s)
 
 
+class Nearest(msgspec.Struct, frozen=True, gc=False):
+    """The charging station nearest a point: its distance and index."""
+
+    distance_m: float
+    station: int
+
+
 class Site:
     """Charging stations (``index`` by id) with memoised distance and
     nearest-station lookups, the end-of-mission policy, and the index of
@@ -78,8 +87,6 @@ class Site:
         "index",
         "points",
         "positions",
-        "swap_s",
-        "wh_s",
     )
 
     def __init__(self, problem: Problem) -> None:
@@ -89,20 +96,10 @@ class Site:
         self.positions = [s.position_m for s in self.charging]
         self.end = problem.end
         self.points = HoldPoints(problem, first=len(self.charging))
-        self._near: dict[Vec3, tuple[float, int]] = {}
+        self._near: dict[Vec3, Nearest] = {}
         self._dists: dict[Vec3, list[float]] = {}
         self._cand: dict[tuple[Vec3, Vec3], tuple[list[int], list[int], float]] = {}
         self._within: dict[tuple[int, float], list[tuple[int, float]]] = {}
-        swaps = [s.swap_s for s in self.charging if s.recharge == "swap"]
-        self.swap_s = min(swaps, default=float("inf"))
-        charges = [s.full_charge_s for s in self.charging if s.recharge == "charge"]
-        self.wh_s = min(charges, default=float("inf"))
-
-    def min_charge_s(self, capacity_wh: float, missing_wh: float) -> float:
-        """A lower bound of the time to recover ``missing_wh`` at any station."""
-        if not self.charging:
-            return 0.0
-        return min(self.swap_s, self.wh_s * missing_wh / capacity_wh)
 
     def dists(self, pos: Vec3) -> list[float]:
         """Distance (m) from ``pos`` to each charging station, by index."""
@@ -125,15 +122,15 @@ class Site:
             ]
         return hit
 
-    def nearest(self, pos: Vec3) -> tuple[float, int]:
-        """(distance m, index in ``charging``) of the nearest charging station."""
+    def nearest(self, pos: Vec3) -> Nearest:
+        """The nearest charging station (index in ``charging``; -1 if none)."""
         hit = self._near.get(pos)
         if hit is None:
-            best = (float("inf"), -1)
+            best_d, best_i = float("inf"), -1
             for i, d in enumerate(self.dists(pos)):
-                if d < best[0]:
-                    best = (d, i)
-            self._near[pos] = hit = best
+                if d < best_d:
+                    best_d, best_i = d, i
+            self._near[pos] = hit = Nearest(best_d, best_i)
         return hit
 
     def candidates(self, a: Vec3, b: Vec3, limit: int = 3) -> tuple[list[int], list[int], float]:
@@ -156,7 +153,7 @@ class Site:
         if n <= limit:
             return list(range(n)), [], shortest
         first = order[:limit]
-        near_a = self.nearest(a)[1]
+        near_a = self.nearest(a).station
         if near_a not in first:
             first.append(near_a)
         taken = set(first)

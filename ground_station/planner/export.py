@@ -4,39 +4,20 @@ from __future__ import annotations
 
 from math import dist
 
-from ground_station.planner.ending import end_steps
+from ground_station.planner.ending import end_steps, landing_step
 from ground_station.planner.metrics import compute_metrics
 from ground_station.planner.result import Plan, Step, UavPlan, Unplaced
 from ground_station.planner.routes import Ctx
 
 
-def to_step(raw: tuple) -> Step:
-    kind, start, arrive, end, e_after, pos, action_id, index, station, tool, d = raw
-    return Step(
-        kind=kind,
-        start_s=start,
-        arrive_s=arrive,
-        end_s=end,
-        position_m=pos,
-        energy_after_wh=e_after,
-        distance_m=d,
-        action_id=action_id,
-        index=index,
-        station=station,
-        tool=tool,
-    )
-
-
 def emergency_steps(ctx: Ctx, uid: str) -> tuple[Step, ...]:
     """Land a UAV that cannot reach a station above the reserve."""
-    sid, st, kin = ctx.emergency[uid]
-    station = ctx.site.by_id[sid]
+    grounded = ctx.emergency[uid]
+    st, station = grounded.state, ctx.site.by_id[grounded.station_id]
     d = dist(st.pos, station.position_m)
     if d < 1e-9 and st.landed:
         return ()
-    end = st.t + d / kin.speed_mps
-    e = st.e - d * kin.wh_per_m
-    return (to_step(("home", st.t, end, end, e, station.position_m, None, None, sid, None, d)),)
+    return (landing_step(grounded.kin, st, station.position_m, station.id, d),)
 
 
 def export(ctx: Ctx) -> Plan:
@@ -52,10 +33,8 @@ def export(ctx: Ctx) -> Plan:
             uavs.append(UavPlan(uav_id=u.id))
             continue
         home, res = end_steps(r.kin, ctx.site, pads, r.tail(), None)
-        for si, s, e in res:
-            pads.add(si, s, e, u.id)
-        steps = tuple(to_step(s) for s in (*r.steps, *home))
-        uavs.append(UavPlan(uav_id=u.id, steps=steps))
+        pads.book(res, u.id)
+        uavs.append(UavPlan(uav_id=u.id, steps=(*r.steps, *home)))
     unplaced: list[Unplaced] = []
     for a in ctx.problem.actions:
         unplaced.extend(ctx.unplaced.get(a.id, ()))

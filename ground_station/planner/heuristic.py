@@ -10,6 +10,8 @@ from __future__ import annotations
 from collections.abc import Callable
 from math import dist
 
+import msgspec
+
 from ground_station.planner import insertion, monitor
 from ground_station.planner.model import (
     Action,
@@ -19,7 +21,7 @@ from ground_station.planner.model import (
     Problem,
     Vec3,
 )
-from ground_station.planner.routes import Ctx, Options, new_ctx, queue_order
+from ground_station.planner.routes import Ctx, Options, Snapshot, new_ctx, queue_order
 from ground_station.planner.simulate import State, Task
 from ground_station.planner.split import chunk_all, equal_chunks, fixed_split_count
 
@@ -32,7 +34,7 @@ RANDOM_SPLIT_P = 0.3
 def reachable(ctx: Ctx, kind: str, pos: Vec3, service_s: float) -> bool:
     """Whether some capable UAV, on a full battery from the nearest station,
     could do ``service_s`` at ``pos`` and get back above the reserve."""
-    d = ctx.site.nearest(pos)[0]
+    d = ctx.site.nearest(pos).distance_m
     for r in ctx.routes.values():
         k = r.kin
         if kind not in k.caps:
@@ -121,31 +123,19 @@ def _place_chunk(ctx: Ctx, a: InspectAction, idx: list[int]) -> tuple[float, flo
 
 
 def place_inspect(ctx: Ctx, a: InspectAction, only: list[int] | None = None) -> None:
-    skip = set(a.done) | {i for aid, i in ctx.pinned if aid == a.id}
-    idx = [i for i in (only if only is not None else range(len(a.waypoints))) if i not in skip]
-    if not idx:
+    """Place an inspection's waypoints (``only`` those, if given) in
+    contiguous chunks; the split count is the best estimate's (paper mode:
+    the paper's fixed count)."""
+    ok = _placeable(ctx, a, only)
+    if not ok:
         return
     caps = ctx.capable("inspect")
-    if not caps:
-        for i in idx:
-            ctx.add_unplaced(a.id, i, "no_capable_uav")
-        return
-    ok = []
-    for i in idx:
-        wp = a.waypoints[i]
-        if reachable(ctx, "inspect", wp.position_m, wp.service_s):
-            ok.append(i)
-        else:
-            ctx.add_unplaced(a.id, i, "unreachable_with_full_battery")
-    if not ok:
+    if ctx.options.mode == "paper":
+        _place_split(ctx, a, ok, equal_chunks(len(ok), min(fixed_split_count(len(ok)), len(caps))))
         return
     pts = [a.waypoints[i].position_m for i in ok]
     serv = [a.waypoints[i].service_s for i in ok]
     speed = min(ctx.routes[u].kin.speed_mps for u in caps)
-    if ctx.options.mode == "paper":
-        for c in equal_chunks(len(ok), min(fixed_split_count(len(ok)), len(caps))):
-            _place_chunk(ctx, a, [ok[j] for j in c])
-        return
     max_split = min(2, ctx.options.max_split) if ctx.fast else ctx.options.max_split
     splits = chunk_all(pts, serv, speed, min(max_split, len(caps), len(ok)))
     # Simulate only the SPLITS_TRIED most promising split counts (by estimate).
@@ -155,30 +145,75 @@ def place_inspect(ctx: Ctx, a: InspectAction, only: list[int] | None = None) -> 
     if ctx.rng is not None and ctx.rng.random() < RANDOM_SPLIT_P:
         tried = [ctx.rng.choice(ranked)]
     if len(tried) == 1:
-        for c in splits[tried[0]]:
-            _place_chunk(ctx, a, [ok[j] for j in c])
-        return
+        _place_split(ctx, a, ok, splits[tried[0]])
+    else:
+        _place_best_split(ctx, a, ok, [splits[m] for m in tried])
+
+
+def _placeable(ctx: Ctx, a: InspectAction, only: list[int] | None) -> list[int]:
+    """The waypoints to place (not done, not running); the others that no
+    UAV can take are reported unplaced."""
+    skip = set(a.done) | {i for aid, i in ctx.pinned if aid == a.id}
+    idx = [i for i in (only if only is not None else range(len(a.waypoints))) if i not in skip]
+    if idx and not ctx.capable("inspect"):
+        for i in idx:
+            ctx.add_unplaced(a.id, i, "no_capable_uav")
+        return []
+    ok = []
+    for i in idx:
+        wp = a.waypoints[i]
+        if reachable(ctx, "inspect", wp.position_m, wp.service_s):
+            ok.append(i)
+        else:
+            ctx.add_unplaced(a.id, i, "unreachable_with_full_battery")
+    return ok
+
+
+def _place_split(
+    ctx: Ctx, a: InspectAction, ok: list[int], chunks: list[list[int]]
+) -> tuple[float, float]:
+    """Place each chunk (indices into ``ok``); (finish, added UAV time)."""
+    finish, used = ctx.problem.now_s, 0.0
+    for c in chunks:
+        f, u = _place_chunk(ctx, a, [ok[j] for j in c])
+        finish, used = max(finish, f), used + u
+    return finish, used
+
+
+def _place_best_split(
+    ctx: Ctx, a: InspectAction, ok: list[int], splits: list[list[list[int]]]
+) -> None:
+    """Place the best of ``splits``: fewest unplaced waypoints, then finish
+    plus ``resource_factor`` x the UAV time used."""
     snap = ctx.snapshot()
-    best: tuple[float, tuple] | None = None
-    for m in tried:
-        finish, used = ctx.problem.now_s, 0.0
-        for c in splits[m]:
-            f, u = _place_chunk(ctx, a, [ok[j] for j in c])
-            finish, used = max(finish, f), used + u
+    best: Snapshot | None = None
+    best_score = 0.0
+    for chunks in splits:
+        finish, used = _place_split(ctx, a, ok, chunks)
         score = finish + ctx.options.resource_factor * used + 1e6 * len(ctx.unplaced.get(a.id, ()))
-        if best is None or score < best[0]:
-            best = (score, ctx.snapshot())
+        if best is None or score < best_score:
+            best, best_score = ctx.snapshot(), score
         ctx.restore(snap)
     assert best is not None
-    ctx.restore(best[1])
+    ctx.restore(best)
+
+
+class _Tail(msgspec.Struct, frozen=True, gc=False):
+    """Where a UAV's route ends, for ``_estimate``: time, position, speed and
+    suitability cost for inspections."""
+
+    uid: str
+    t: float
+    pos: Vec3
+    speed_mps: float
+    suit_cost: float
 
 
 def _estimate(
-    ctx: Ctx, a: InspectAction, ok: list[int], chunks: list[list[int]], fleet: list[tuple]
+    ctx: Ctx, a: InspectAction, ok: list[int], chunks: list[list[int]], fleet: list[_Tail]
 ) -> float:
     """Cheap score of a split: each chunk on the UAV that could finish it
-    first (tails only, no battery), as ``place_inspect`` scores real splits.
-    ``fleet``: ``(uid, tail time, tail position, speed, suitability cost)``."""
+    first (tails only, no battery), as ``place_inspect`` scores real splits."""
     wps = a.waypoints
     release = a.release_s
     taken: set[str] = set()
@@ -188,32 +223,35 @@ def _estimate(
         work = sum(wps[ok[j]].service_s for j in c)
         path = sum(dist(pts[i - 1], pts[i]) for i in range(1, len(pts)))
         first = pts[0]
-        best = None
-        for uid, t, pos, speed, suit_cost in fleet:
-            if uid in taken:
+        best_uid: str | None = None  # the UAV that finishes the chunk first
+        best_cost = best_fin = best_used = 0.0
+        for tail in fleet:
+            if tail.uid in taken:
                 continue
-            fin = t + dist(pos, first) / speed
+            speed = tail.speed_mps
+            fin = tail.t + dist(tail.pos, first) / speed
             if fin < release:
                 fin = release
             fin += work + path / speed
-            cost = fin + suit_cost
-            if best is None or cost < best[0]:
-                best = (cost, fin, fin - t, uid)
-        if best is None:
+            cost = fin + tail.suit_cost
+            if best_uid is None or cost < best_cost:
+                best_uid, best_cost, best_fin, best_used = tail.uid, cost, fin, fin - tail.t
+        if best_uid is None:
             return float("inf")
-        taken.add(best[3])
-        finish, used = max(finish, best[1]), used + best[2]
+        taken.add(best_uid)
+        finish, used = max(finish, best_fin), used + best_used
     return finish + ctx.options.resource_factor * used
 
 
-def _fleet(ctx: Ctx, uids: list[str]) -> list[tuple]:
+def _fleet(ctx: Ctx, uids: list[str]) -> list[_Tail]:
     """The route tails ``_estimate`` scores chunks against."""
     out = []
     for uid in uids:
         r = ctx.routes[uid]
         st = r.tail()
         k = r.kin
-        out.append((uid, st.t, st.pos, k.speed_mps, ctx.weights.suitability_s * k.caps["inspect"]))
+        suit_cost = ctx.weights.suitability_s * k.caps["inspect"]
+        out.append(_Tail(uid, st.t, st.pos, k.speed_mps, suit_cost))
     return out
 
 

@@ -19,14 +19,15 @@ from __future__ import annotations
 
 import random
 from collections.abc import Callable
+from typing import NamedTuple
 
 from msgspec.structs import replace
 
 from ground_station.planner import heuristic
 from ground_station.planner.ending import end_steps
 from ground_station.planner.model import CostWeights
-from ground_station.planner.removal import remove_in_place
-from ground_station.planner.routes import Ctx, queue_order
+from ground_station.planner.removal import remove
+from ground_station.planner.routes import Ctx, Snapshot, queue_order
 from ground_station.planner.simulate import Task
 
 THRESHOLD = 0.002
@@ -40,7 +41,15 @@ RANDOM_P = 0.5
 """Share of rounds that re-insert with randomised choices (``_recreate``)."""
 
 
-def objective(ctx: Ctx) -> tuple[int, float]:
+class Score(NamedTuple):
+    """What improvement minimises, in this order: unplaced parts, then
+    weight-averaged completion + makespan (s)."""
+
+    unplaced: int
+    cost_s: float
+
+
+def objective(ctx: Ctx) -> Score:
     """(unplaced parts, weight-averaged completion + makespan) of the state.
 
     The makespan counts each UAV's way home, with a recharge first where one
@@ -48,24 +57,30 @@ def objective(ctx: Ctx) -> tuple[int, float]:
     UAVs going home).
     """
     now = ctx.problem.now_s
-    comp: dict[str, float] = {}
     makespan = now
     for r in ctx.routes.values():
         home, _ = end_steps(r.kin, ctx.site, ctx.pads, r.tail(), None)
-        t = home[-1][3] if home else r.tail()[0]
+        t = home[-1].end_s if home else r.tail().t
         if t > makespan:
             makespan = t
-        for s in r.steps:
-            aid = s[6]
-            if aid is not None and s[3] > comp.get(aid, -1e300):
-                comp[aid] = s[3]
     failed = sum(len(v) for v in ctx.unplaced.values())
     weighted = 0.0
-    for aid, c in comp.items():
+    for aid, c in _completions(ctx).items():
         if aid not in ctx.unplaced:
             weighted += ctx.actions[aid].weight * (c - now)
     total = sum(a.weight for a in ctx.problem.actions) or 1.0
-    return failed, weighted / total + makespan - now
+    return Score(failed, weighted / total + makespan - now)
+
+
+def _completions(ctx: Ctx) -> dict[str, float]:
+    """Per placed action, the end of its last step."""
+    comp: dict[str, float] = {}
+    for r in ctx.routes.values():
+        for s in r.steps:
+            aid = s.action_id
+            if aid is not None and s.end_s > comp.get(aid, -1e300):
+                comp[aid] = s.end_s
+    return comp
 
 
 def _related(ctx: Ctx, seed: str, rng: random.Random, size: int) -> list[str]:
@@ -88,7 +103,7 @@ def _related(ctx: Ctx, seed: str, rng: random.Random, size: int) -> list[str]:
 
 def _late(ctx: Ctx) -> list[str]:
     """Actions among the last tasks of the UAV that finishes last."""
-    r = max(ctx.routes.values(), key=lambda r: r.tail()[0])
+    r = max(ctx.routes.values(), key=lambda r: r.tail().t)
     return [t.action_id for t in r.tasks[-3:] if (t.action_id, t.index) not in ctx.pinned]
 
 
@@ -98,22 +113,26 @@ def _remove(ctx: Ctx, aid: str) -> bool:
         def mine(t: Task) -> bool:
             return t.action_id == aid and (aid, t.index) not in ctx.pinned
 
-        if ctx.remove_tasks(uid, mine) is None and remove_in_place(ctx, uid, mine) is None:
+        if not remove(ctx, uid, mine):
             return False
     ctx.unplaced.pop(aid, None)
     return True
 
 
-def _contributions(ctx: Ctx) -> list[tuple[float, str]]:
-    """Per placed action, weight x completion (the worst are the best to move)."""
+class _Contribution(NamedTuple):
+    """A placed action's weight x completion (from ``now_s``)."""
+
+    cost: float
+    action_id: str
+
+
+def _contributions(ctx: Ctx) -> list[_Contribution]:
+    """Per placed action, weight x completion, worst (the best to move) first."""
     now = ctx.problem.now_s
-    comp: dict[str, float] = {}
-    for r in ctx.routes.values():
-        for s in r.steps:
-            aid = s[6]
-            if aid is not None and s[3] > comp.get(aid, -1e300):
-                comp[aid] = s[3]
-    return sorted(((ctx.actions[a].weight * (c - now), a) for a, c in comp.items()), reverse=True)
+    return sorted(
+        (_Contribution(ctx.actions[a].weight * (c - now), a) for a, c in _completions(ctx).items()),
+        reverse=True,
+    )
 
 
 def improve(
@@ -130,11 +149,8 @@ def improve(
     ids = [a.id for a in ctx.problem.actions]
     if not ids or not ctx.routes:
         return 0
-    best = current = objective(ctx)
-    best_snap = None
-    accepted = 0
-    stale = 0
-    worst: list[tuple[float, str]] = []
+    search = _Threshold(ctx, objective(ctx))
+    worst: list[_Contribution] = []
     weights = ctx.weights
     ctx.anywhere = True
     try:
@@ -143,45 +159,80 @@ def improve(
                 break
             if n % 25 == 0:
                 worst = _contributions(ctx)[:20]
-            x = rng.random()
-            late = _late(ctx) if x < LATE_P else []
-            if late:
-                seed_id = rng.choice(late)
-            elif worst and x < 0.5:
-                seed_id = rng.choice(worst)[1]
-            else:
-                seed_id = rng.choice(ids)
+            seed_id = _pick_seed(ctx, rng, ids, worst)
             group = _related(ctx, seed_id, rng, rng.choice((1, 1, 2, 3)))
             snap = ctx.snapshot()
-            ok = all(_remove(ctx, aid) for aid in group)
-            if ok:
+            score = None
+            if all(_remove(ctx, aid) for aid in group):
                 _recreate(ctx, group, rng, weights)
                 score = objective(ctx)
-                if score < best:
-                    best = current = score
-                    best_snap = None
-                    accepted += 1
-                    stale = 0
-                    continue
-                if score[0] == current[0] and score[1] <= current[1] * (1 + THRESHOLD):
-                    if best_snap is None:
-                        best_snap = snap
-                    current = score
-                    stale += 1
-                    if stale > RESTART_AFTER:
-                        ctx.restore(best_snap)
-                        best_snap, current, stale = None, best, 0
-                    continue
-            ctx.restore(snap)
-            stale += 1
-            if stale > RESTART_AFTER and best_snap is not None:
-                ctx.restore(best_snap)
-                best_snap, current, stale = None, best, 0
-        if best_snap is not None:
-            ctx.restore(best_snap)
+            search.judge(snap, score)
+        search.finish()
     finally:
         ctx.anywhere, ctx.rng, ctx.weights = False, None, weights
-    return accepted
+    return search.accepted
+
+
+def _pick_seed(ctx: Ctx, rng: random.Random, ids: list[str], worst: list[_Contribution]) -> str:
+    """A round's seed action: one of the last tasks of the UAV that finishes
+    last (``LATE_P``), one of the ``worst`` contributions, or any action."""
+    x = rng.random()
+    late = _late(ctx) if x < LATE_P else []
+    if late:
+        return rng.choice(late)
+    if worst and x < 0.5:
+        return rng.choice(worst).action_id
+    return rng.choice(ids)
+
+
+class _Threshold:
+    """Threshold acceptance over rounds: the best and current objectives, and
+    the best state to go back to (None while the current state is the best)."""
+
+    def __init__(self, ctx: Ctx, score: Score) -> None:
+        self.ctx = ctx
+        self.best = self.current = score
+        self.best_snap: Snapshot | None = None
+        self.stale = 0  # rounds without a new best
+        self.accepted = 0  # rounds that found a new best
+
+    def judge(self, snap: Snapshot, score: Score | None) -> None:
+        """Keep a round's state (objective ``score``; None if the round
+        failed) or go back to ``snap``, the state before it; after
+        ``RESTART_AFTER`` rounds without a new best, go back to the best."""
+        if score is not None:
+            if score < self.best:
+                self.best = self.current = score
+                self.best_snap = None
+                self.accepted += 1
+                self.stale = 0
+                return
+            current = self.current
+            if score.unplaced == current.unplaced and score.cost_s <= current.cost_s * (
+                1 + THRESHOLD
+            ):
+                if self.best_snap is None:
+                    self.best_snap = snap
+                self.current = score
+                self.stale += 1
+                if self.stale > RESTART_AFTER:
+                    self._back_to_best()
+                return
+        self.ctx.restore(snap)
+        self.stale += 1
+        if self.stale > RESTART_AFTER and self.best_snap is not None:
+            self._back_to_best()
+
+    def _back_to_best(self) -> None:
+        """Restart from the best state seen."""
+        assert self.best_snap is not None
+        self.ctx.restore(self.best_snap)
+        self.best_snap, self.current, self.stale = None, self.best, 0
+
+    def finish(self) -> None:
+        """Leave the best state seen."""
+        if self.best_snap is not None:
+            self.ctx.restore(self.best_snap)
 
 
 def _recreate(ctx: Ctx, group: list[str], rng: random.Random, weights: CostWeights) -> None:

@@ -9,6 +9,7 @@ import msgspec
 from ground_station.planner.errors import PlanningProblemError
 from ground_station.planner.model import (
     KINDS,
+    Action,
     DeliverAction,
     InspectAction,
     MonitorAction,
@@ -80,11 +81,26 @@ def check_problem(p: Problem) -> None:
     _unique("$.uav_types", [t.id for t in p.uav_types])
     _unique("$.uavs", [u.id for u in p.uavs])
     _unique("$.actions", [a.id for a in p.actions])
+    _check_stations(p)
+    _check_uav_types(p)
+    _check_uavs(p)
+    tool_stations = {s.id for s in p.tool_stations}
+    for i, a in enumerate(p.actions):
+        _check_action(f"$.actions[{i}]", a, tool_stations)
+    _check_running(p)
+
+
+def _check_stations(p: Problem) -> None:
+    """Pads, swap and charge times."""
     for i, s in enumerate(p.stations):
         if s.pads < 0:
             raise PlanningProblemError(f"$.stations[{i}].pads", "must be >= 0")
         _positive(f"$.stations[{i}].swap_s", s.swap_s, zero_ok=True)
         _positive(f"$.stations[{i}].full_charge_s", s.full_charge_s)
+
+
+def _check_uav_types(p: Problem) -> None:
+    """Speeds, battery, powers and capabilities (known kinds, costs 0..1)."""
     for i, t in enumerate(p.uav_types):
         base = f"$.uav_types[{i}]"
         _positive(f"{base}.cruise_speed_mps", t.cruise_speed_mps)
@@ -96,6 +112,10 @@ def check_problem(p: Problem) -> None:
                 raise PlanningProblemError(f"{base}.capabilities.{kind}", "unknown action kind")
             if not 0 <= cost <= 1:
                 raise PlanningProblemError(f"{base}.capabilities.{kind}", "must be in [0, 1]")
+
+
+def _check_uavs(p: Problem) -> None:
+    """Each UAV's type, home, battery and running task's remaining time."""
     stations = {s.id for s in p.stations}
     types = {t.id: t for t in p.uav_types}
     for i, u in enumerate(p.uavs):
@@ -111,32 +131,37 @@ def check_problem(p: Problem) -> None:
             raise PlanningProblemError(f"{base}.energy_wh", "exceeds the battery capacity")
         if u.running is not None:
             _positive(f"{base}.running.remaining_s", u.running.remaining_s, zero_ok=True)
-    tool_stations = {s.id: s for s in p.tool_stations}
+
+
+def _check_action(base: str, a: Action, tool_stations: set[str]) -> None:
+    """One action's fields (``base`` is its path)."""
+    _positive(f"{base}.weight", a.weight)
+    _positive(f"{base}.release_s", a.release_s, zero_ok=True)
+    if isinstance(a, InspectAction):
+        if not a.waypoints:
+            raise PlanningProblemError(f"{base}.waypoints", "must not be empty")
+        for j, w in enumerate(a.waypoints):
+            _positive(f"{base}.waypoints[{j}].service_s", w.service_s, zero_ok=True)
+        for j, d in enumerate(a.done):
+            if not 0 <= d < len(a.waypoints):
+                raise PlanningProblemError(f"{base}.done[{j}]", "waypoint index out of range")
+    elif isinstance(a, MonitorAction):
+        _positive(f"{base}.duration_s", a.duration_s)
+        _positive(f"{base}.standoff_m", a.standoff_m, zero_ok=True)
+        if a.k < 1:
+            raise PlanningProblemError(f"{base}.k", "must be >= 1")
+    elif isinstance(a, DeliverAction):
+        _positive(f"{base}.pick_s", a.pick_s, zero_ok=True)
+        _positive(f"{base}.drop_s", a.drop_s, zero_ok=True)
+        if a.tool_station not in tool_stations:
+            raise PlanningProblemError(
+                f"{base}.tool_station", f"unknown tool station {a.tool_station!r}"
+            )
+
+
+def _check_running(p: Problem) -> None:
+    """A running task names a released action the UAV can be running."""
     actions = {a.id: a for a in p.actions}
-    for i, a in enumerate(p.actions):
-        base = f"$.actions[{i}]"
-        _positive(f"{base}.weight", a.weight)
-        _positive(f"{base}.release_s", a.release_s, zero_ok=True)
-        if isinstance(a, InspectAction):
-            if not a.waypoints:
-                raise PlanningProblemError(f"{base}.waypoints", "must not be empty")
-            for j, w in enumerate(a.waypoints):
-                _positive(f"{base}.waypoints[{j}].service_s", w.service_s, zero_ok=True)
-            for j, d in enumerate(a.done):
-                if not 0 <= d < len(a.waypoints):
-                    raise PlanningProblemError(f"{base}.done[{j}]", "waypoint index out of range")
-        elif isinstance(a, MonitorAction):
-            _positive(f"{base}.duration_s", a.duration_s)
-            _positive(f"{base}.standoff_m", a.standoff_m, zero_ok=True)
-            if a.k < 1:
-                raise PlanningProblemError(f"{base}.k", "must be >= 1")
-        elif isinstance(a, DeliverAction):
-            _positive(f"{base}.pick_s", a.pick_s, zero_ok=True)
-            _positive(f"{base}.drop_s", a.drop_s, zero_ok=True)
-            if a.tool_station not in tool_stations:
-                raise PlanningProblemError(
-                    f"{base}.tool_station", f"unknown tool station {a.tool_station!r}"
-                )
     for i, u in enumerate(p.uavs):
         if u.running is None:
             continue

@@ -16,7 +16,6 @@ import msgspec
 Vec3 = tuple[float, float, float]
 """A point (x, y, z) in metres in the site's local ENU frame."""
 
-Kind = Literal["inspect", "monitor", "deliver"]
 KINDS: tuple[str, ...] = ("deliver", "inspect", "monitor")
 
 End = Literal["home", "any_station"]

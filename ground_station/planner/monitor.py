@@ -16,14 +16,19 @@ rest but never moves a frozen one) gets only its slots without one.
 from __future__ import annotations
 
 import heapq
+from collections.abc import Iterable
 from math import dist
+from typing import NamedTuple
+
+import msgspec
 
 from ground_station.planner import costs
 from ground_station.planner.energy import EPS_S
 from ground_station.planner.model import MonitorAction, Vec3, slot_position
 from ground_station.planner.monitor_start import ReadyTimes, start_times
-from ground_station.planner.routes import Ctx
-from ground_station.planner.simulate import Task, monitor_reach
+from ground_station.planner.reach import monitor_reach
+from ground_station.planner.routes import Ctx, Snapshot
+from ground_station.planner.simulate import Task
 
 MAX_REACH = 3
 """UAVs (best first by suitability and distance) examined for each segment."""
@@ -44,12 +49,63 @@ can start at least this much earlier now (a UAV came back or was freed):
 small gains never move a start the UAVs are already flying to."""
 
 
+class Need(msgspec.Struct, frozen=True, order=True, gc=False):
+    """Slot ``slot`` to cover from ``start_s`` until ``end_s`` (ordered by start)."""
+
+    start_s: float
+    slot: int
+    end_s: float
+
+
+def segment_needs(tasks: Iterable[Task]) -> list[Need]:
+    """What the monitoring segments among ``tasks`` cover."""
+    return [
+        Need(t.anchor_s, t.index, t.anchor_s + t.service_s)
+        for t in tasks
+        if t.kind == "monitor" and t.anchor_s is not None and t.index is not None
+    ]
+
+
+class _Member(msgspec.Struct, frozen=True, gc=False):
+    """A capable UAV: its fixed cost (suitability and interruption) and suitability."""
+
+    uid: str
+    fixed_cost: float
+    suit: float
+
+
+_Ranked = tuple[float, str, float, int]
+"""A UAV that can start a segment: (rank cost, uid, suitability, route
+position). A plain tuple, unpacked where used: ``list.sort`` compares exact
+tuples several times faster than Structs or NamedTuples, and these are
+sorted by the fleet for every segment tried."""
+
+
+class _Offer(msgspec.Struct, frozen=True, order=True, gc=False):
+    """A segment a UAV can fly until ``end_s``: rank cost (less the time it
+    covers), suitability, route position."""
+
+    cost: float
+    uid: str
+    end_s: float
+    suit: float
+    position: int
+
+
+class _Coverage(NamedTuple):
+    """A full coverage tried: its cost, its start and the state with it."""
+
+    cost: float
+    start_s: float
+    snapshot: Snapshot
+
+
 def _cover(
     ctx: Ctx, a: MonitorAction, t0: float, uids: list[str], ready: dict[str, float] | None = None
 ) -> float | None:
     """Tentatively commit a full coverage from ``t0``; its cost, or None."""
     end = t0 + a.duration_s
-    return _cover_needs(ctx, a, [(t0, s, end) for s in range(a.k)], uids, ready=ready)
+    return _cover_needs(ctx, a, [Need(t0, s, end) for s in range(a.k)], uids, ready=ready)
 
 
 def _push_position(ctx: Ctx, uid: str, pos: Vec3, t: float) -> int | None:
@@ -66,104 +122,134 @@ def _push_position(ctx: Ctx, uid: str, pos: Vec3, t: float) -> int | None:
     return None
 
 
-def _rank_uavs(
-    ctx: Ctx, fleet: list[tuple[str, float, float]], pos: Vec3, t: float, push: bool
-) -> list[tuple[float, str, float, int]]:
-    """``(rank cost, uid, suitability, route position)`` of each UAV in
-    ``fleet`` (``(uid, fixed cost, suitability)``) that can start a segment at
-    ``pos`` at ``t``: at the end of its route if it is free by then; with
+def _rank_uavs(ctx: Ctx, fleet: list[_Member], pos: Vec3, t: float, push: bool) -> list[_Ranked]:
+    """The UAVs of ``fleet`` that can start a segment at ``pos`` at ``t``,
+    best first: at the end of its route if it is free by then; with
     ``push``, also before its later tasks (at a penalty)."""
-    out = []
-    for uid, fixed, suit in fleet:
+    out: list[_Ranked] = []
+    for m in fleet:
+        uid = m.uid
         r = ctx.routes[uid]
         speed = r.kin.speed_mps
         st = r.tail()
         travel_s = dist(st.pos, pos) / speed
         if st.t + travel_s <= t + EPS_S:
-            out.append((fixed + MON_TRAVEL * travel_s, uid, suit, len(r.tasks)))
+            out.append((m.fixed_cost + MON_TRAVEL * travel_s, uid, m.suit, len(r.tasks)))
             continue
         p = _push_position(ctx, uid, pos, t) if push else None
         if p is not None:
             travel_s = dist(r.state_before(p).pos, pos) / speed
-            out.append((fixed + MON_TRAVEL * travel_s + PUSH_PENALTY_S, uid, suit, p))
+            cost = m.fixed_cost + MON_TRAVEL * travel_s + PUSH_PENALTY_S
+            out.append((cost, uid, m.suit, p))
     out.sort()
+    return out
+
+
+def _members(ctx: Ctx, a: MonitorAction, uids: list[str]) -> list[_Member]:
+    """The UAVs ``uids`` with their fixed costs for ``a``."""
+    w = ctx.weights
+    out = []
+    for uid in uids:
+        suit = costs.j1(ctx.routes[uid].kin.caps, "monitor")
+        jv = costs.j3(ctx.running.get(uid), a.id)
+        out.append(_Member(uid, w.suitability_s * suit + w.interruption_s * jv, suit))
     return out
 
 
 def _cover_needs(
     ctx: Ctx,
     a: MonitorAction,
-    needs: list[tuple[float, int, float]],
+    needs: list[Need],
     uids: list[str],
     push: bool = False,
     ready: dict[str, float] | None = None,
 ) -> float | None:
-    """Commit segments covering each (from, slot, until) with hand-overs.
+    """Commit segments covering each need with hand-overs; their cost, or None.
     With ``push`` a segment may also go before a UAV's later tasks.
     ``ready`` (lower bounds of the UAVs' ready times, ``ReadyTimes.bound``)
     skips UAVs that cannot be at a slot by then, until they take a segment."""
-    min_seg = ctx.problem.min_monitor_segment_s
     slots = [slot_position(a, s) for s in range(a.k)]
     need = list(needs)
     heapq.heapify(need)
-    end = max(e for _, _, e in needs)
-    w = ctx.weights
-    fleet = []
-    for uid in uids:
-        suit = costs.j1(ctx.routes[uid].kin.caps, "monitor")
-        jv = costs.j3(ctx.running.get(uid), a.id)
-        fleet.append((uid, w.suitability_s * suit + w.interruption_s * jv, suit))
+    end = max(n.end_s for n in needs)
+    fleet = _members(ctx, a, uids)
     suit_sum = 0.0
     handovers = 0
     moved: set[str] = set()
-    inf = float("inf")
     while need:
-        t, s, end = heapq.heappop(need)
-        pos = slots[s]
-        pre = _rank_uavs(ctx, fleet, pos, t, push)
-        ranked: list[tuple[float, str, float, float, int]] = []
-        for base, uid, suit, p in pre:
-            if len(ranked) >= MAX_REACH:
-                break
-            r = ctx.routes[uid]
-            slack = 2 * a.standoff_m / r.kin.speed_mps + EPS_S  # slot 0 to slot s
-            if ready is not None and uid not in moved and ready.get(uid, inf) > t + slack:
-                continue
-            st = r.state_before(p)
-            reach = monitor_reach(r.kin, ctx.site, ctx.pads, st, pos, t, (uid, st.t), end)
-            if reach is None:
-                continue
-            seg_end = min(end, reach)
-            if ctx.rng is not None and ctx.rng.random() < SHORTEN_P:
-                seg_end = t + (seg_end - t) * ctx.rng.uniform(*SHORTEN)
-            if seg_end < end - EPS_S and seg_end - t < min_seg:
-                continue
-            ranked.append((base - (seg_end - t), uid, seg_end, suit, p))
-        ranked.sort()
-        if ctx.rng is not None and len(ranked) > 1 and ctx.rng.random() < SHUFFLE_P:
-            ctx.rng.shuffle(ranked)
-        for _, uid, seg_end, suit, p in ranked:
-            task = Task("monitor", a.id, s, pos, seg_end - t, a.release_s, anchor_s=t)
-            sim = ctx.try_insert(uid, p, [task])
-            if isinstance(sim, str):
-                continue
-            ctx.commit(uid, p, [task], sim)
-            moved.add(uid)
-            suit_sum += suit * (seg_end - t) / a.duration_s
-            if seg_end < end - EPS_S:
-                heapq.heappush(need, (seg_end, s, end))
-                handovers += 1
-            break
-        else:
+        cur = heapq.heappop(need)
+        t, end = cur.start_s, cur.end_s
+        pre = _rank_uavs(ctx, fleet, slots[cur.slot], t, push)
+        offers = _offers(ctx, a, pre, cur, slots[cur.slot], ready, moved)
+        taken = _commit_first(ctx, a, offers, cur, slots[cur.slot])
+        if taken is None:
             return None
+        moved.add(taken.uid)
+        suit_sum += taken.suit * (taken.end_s - t) / a.duration_s
+        if taken.end_s < end - EPS_S:
+            heapq.heappush(need, Need(taken.end_s, cur.slot, end))
+            handovers += 1
+    w = ctx.weights
     return (
         w.suitability_s * suit_sum + w.travel * (end - ctx.problem.now_s) * a.k + 10.0 * handovers
     )
 
 
-def repair(ctx: Ctx, a: MonitorAction, gaps: list[tuple[float, int, float]]) -> bool:
-    """Cover the (from, slot, until) intervals a lost UAV leaves, without
-    touching the rest of the monitoring; False (unchanged) if impossible."""
+def _offers(
+    ctx: Ctx,
+    a: MonitorAction,
+    pre: list[_Ranked],
+    need: Need,
+    pos: Vec3,
+    ready: dict[str, float] | None,
+    moved: set[str],
+) -> list[_Offer]:
+    """The segments the first ``MAX_REACH`` UAVs of ``pre`` that can get to
+    ``pos`` by ``need.start_s`` would fly, best first (improvement may cut
+    them short or shuffle them)."""
+    t, end = need.start_s, need.end_s
+    min_seg = ctx.problem.min_monitor_segment_s
+    out: list[_Offer] = []
+    for rank_cost, uid, suit, p in pre:
+        if len(out) >= MAX_REACH:
+            break
+        r = ctx.routes[uid]
+        slack = 2 * a.standoff_m / r.kin.speed_mps + EPS_S  # slot 0 to slot s
+        if ready is not None and uid not in moved and ready.get(uid, float("inf")) > t + slack:
+            continue
+        st = r.state_before(p)
+        reach = monitor_reach(r.kin, ctx.site, ctx.pads, st, pos, t, (uid, st.t), end)
+        if reach is None:
+            continue
+        seg_end = min(end, reach)
+        if ctx.rng is not None and ctx.rng.random() < SHORTEN_P:
+            seg_end = t + (seg_end - t) * ctx.rng.uniform(*SHORTEN)
+        if seg_end < end - EPS_S and seg_end - t < min_seg:
+            continue
+        out.append(_Offer(rank_cost - (seg_end - t), uid, seg_end, suit, p))
+    out.sort()
+    if ctx.rng is not None and len(out) > 1 and ctx.rng.random() < SHUFFLE_P:
+        ctx.rng.shuffle(out)
+    return out
+
+
+def _commit_first(
+    ctx: Ctx, a: MonitorAction, offers: list[_Offer], need: Need, pos: Vec3
+) -> _Offer | None:
+    """Commit the first of ``offers`` that simulates; None if none does."""
+    t = need.start_s
+    for offer in offers:
+        task = Task("monitor", a.id, need.slot, pos, offer.end_s - t, a.release_s, anchor_s=t)
+        sim = ctx.try_insert(offer.uid, offer.position, [task])
+        if not isinstance(sim, str):
+            ctx.commit(offer.uid, offer.position, [task], sim)
+            return offer
+    return None
+
+
+def repair(ctx: Ctx, a: MonitorAction, gaps: list[Need]) -> bool:
+    """Cover the needs a lost UAV leaves, without touching the rest of the
+    monitoring; False (unchanged) if impossible."""
     snap = ctx.snapshot()
     if _cover_needs(ctx, a, gaps, ctx.capable("monitor"), push=True) is not None:
         return True
@@ -185,16 +271,13 @@ def _complete_kept(ctx: Ctx, a: MonitorAction, uids: list[str]) -> bool:
     round kept), cover only the slots without one over the kept segments'
     window, never a second coverage beside them; True if so (unplaced if
     that is impossible)."""
-    kept = [
-        (t.anchor_s, t.anchor_s + t.service_s, t.index)
-        for uid in ctx.placed_uavs(a.id)
-        for t in ctx.routes[uid].tasks
-        if t.action_id == a.id and t.anchor_s is not None
-    ]
+    kept = segment_needs(
+        t for uid in ctx.placed_uavs(a.id) for t in ctx.routes[uid].tasks if t.action_id == a.id
+    )
     if not kept:
         return False
-    start, end = min(k[0] for k in kept), max(k[1] for k in kept)
-    needs = [(start, s, end) for s in range(a.k) if s not in {k[2] for k in kept}]
+    start, end = min(k.start_s for k in kept), max(k.end_s for k in kept)
+    needs = [Need(start, s, end) for s in range(a.k) if s not in {k.slot for k in kept}]
     if needs:
         snap = ctx.snapshot()
         if _cover_needs(ctx, a, needs, uids) is None:
@@ -204,6 +287,8 @@ def _complete_kept(ctx: Ctx, a: MonitorAction, uids: list[str]) -> bool:
 
 
 def place_monitor(ctx: Ctx, a: MonitorAction) -> None:
+    """Cover ``a`` from the best start tried (a promised start stands unless
+    a clearly earlier one works), or report it unplaced."""
     uids = ctx.capable("monitor")
     if not uids:
         ctx.add_unplaced(a.id, None, "no_capable_uav")
@@ -213,14 +298,8 @@ def place_monitor(ctx: Ctx, a: MonitorAction) -> None:
         return
     if _complete_kept(ctx, a, uids):
         return
-    pos0 = slot_position(a, 0)
-    d = ctx.site.nearest(pos0)[0]
     min_seg = min(ctx.problem.min_monitor_segment_s, a.duration_s)
-    if not any(
-        (k := ctx.routes[u].kin).capacity_wh - 2 * d * k.wh_per_m - k.hover_whps * min_seg
-        >= k.reserve_wh
-        for u in uids
-    ):
+    if not _reachable(ctx, a, uids, min_seg):
         ctx.add_unplaced(a.id, None, "unreachable_with_full_battery")
         return
     base = max(a.release_s, ctx.problem.now_s)
@@ -233,9 +312,36 @@ def place_monitor(ctx: Ctx, a: MonitorAction) -> None:
     if t0 is None:
         ctx.add_unplaced(a.id, None, "monitor_coverage_infeasible")
         return
+    best = _best_coverage(ctx, a, uids, ready, t0)
+    retry = promised is not None and not keep and (best is None or best.start_s > promised)
+    if retry and promised is not None and _keep_start(ctx, a, promised, uids):
+        return  # the earlier start did not work out: the promise stands (not tried yet)
+    if best is None:
+        ctx.add_unplaced(a.id, None, "monitor_coverage_infeasible")
+        return
+    ctx.restore(best.snapshot)
+
+
+def _reachable(ctx: Ctx, a: MonitorAction, uids: list[str], min_seg: float) -> bool:
+    """Whether some UAV, on a full battery from the nearest station, could
+    watch slot 0 for ``min_seg`` and get back above the reserve."""
+    d = ctx.site.nearest(slot_position(a, 0)).distance_m
+    return any(
+        (k := ctx.routes[u].kin).capacity_wh - 2 * d * k.wh_per_m - k.hover_whps * min_seg
+        >= k.reserve_wh
+        for u in uids
+    )
+
+
+def _best_coverage(
+    ctx: Ctx, a: MonitorAction, uids: list[str], ready: ReadyTimes, t0: float
+) -> _Coverage | None:
+    """The cheapest coverage from the first candidate starts, or else from
+    the first fallback start that works (``start_times``); the state is
+    left as it was."""
     primary, fallback = start_times(ctx, a, ready, t0)
     snap = ctx.snapshot()
-    best: tuple[float, float, tuple] | None = None
+    best: _Coverage | None = None
     tried: set[float] = set()
     for group in (primary, fallback):
         for t in group:
@@ -243,17 +349,11 @@ def place_monitor(ctx: Ctx, a: MonitorAction) -> None:
                 continue
             tried.add(t)
             cost = _cover(ctx, a, t, uids, ready.bound)
-            if cost is not None and (best is None or cost < best[0]):
-                best = (cost, t, ctx.snapshot())
+            if cost is not None and (best is None or cost < best.cost):
+                best = _Coverage(cost, t, ctx.snapshot())
             ctx.restore(snap)
             if best is not None and group is fallback:
                 break
         if best is not None:
             break
-    retry = promised is not None and not keep and (best is None or best[1] > promised)
-    if retry and promised is not None and _keep_start(ctx, a, promised, uids):
-        return  # the earlier start did not work out: the promise stands (not tried yet)
-    if best is None:
-        ctx.add_unplaced(a.id, None, "monitor_coverage_infeasible")
-        return
-    ctx.restore(best[2])
+    return best

@@ -13,8 +13,8 @@ import heapq
 from collections.abc import Iterator
 
 from ground_station.planner.model import MonitorAction, slot_position
+from ground_station.planner.reach import direct_arrival, hold_floor_wh, monitor_ready
 from ground_station.planner.routes import Ctx
-from ground_station.planner.simulate import direct_arrival, hold_floor_wh, monitor_ready
 
 MAX_T0_CANDIDATES = 2
 """Start times tried first (the k-th earliest ready time, then later ones)."""

@@ -3,32 +3,41 @@
 from __future__ import annotations
 
 from bisect import bisect_left, insort
+from collections.abc import Iterable
 
 from ground_station.planner.energy import EPS_S
+from ground_station.planner.state import Booking
 
 Ignore = tuple[str, float] | None
 """(uav_id, from_s): that UAV's reservations starting at or after from_s are
 ignored (they are being re-planned)."""
 
+Reservation = tuple[float, float, str]
+"""(start_s, end_s, uav_id) on one resource. The timelines keep plain tuples,
+always unpacked: they are searched with ``bisect`` probes such as ``(t,)``,
+and a named tuple measurably slowed full plans (its constructor is a Python
+function; tuples of scalars also leave the garbage collector's lists)."""
+UavReservation = tuple[float, float, int]
+"""(start_s, end_s, resource) of one UAV, likewise."""
 
-_NONE: list[tuple[float, float, str]] = []
+_NONE: list[Reservation] = []
 
 
 class Pads:
-    """Reservations ``(start_s, end_s, uav_id)`` per resource index (a
-    charging station's pads (``capacity``), or after them a hold point,
-    taken one UAV at a time), sorted by start. Sparse: only resources ever
-    reserved hold a list, and each UAV's reservations are indexed by start
-    (``by_uav``), so that thousands of hold points cost nothing until used
-    and dropping a UAV's reservations costs what it drops."""
+    """Reservations per resource index (a charging station's pads
+    (``capacity``), or after them a hold point, taken one UAV at a time),
+    sorted by start. Sparse: only resources ever reserved hold a list, and
+    each UAV's reservations are indexed by start (``by_uav``), so that
+    thousands of hold points cost nothing until used and dropping a UAV's
+    reservations costs what it drops."""
 
     __slots__ = ("by_uav", "capacity", "longest", "slots")
 
     def __init__(self, capacity: list[int]) -> None:
         self.capacity = capacity  # per charging station; any later index has 1
-        self.slots: dict[int, list[tuple[float, float, str]]] = {}
+        self.slots: dict[int, list[Reservation]] = {}
         self.longest: dict[int, float] = {}  # no reservation was ever longer (s)
-        self.by_uav: dict[str, list[tuple[float, float, int]]] = {}  # (start, end, si)
+        self.by_uav: dict[str, list[UavReservation]] = {}
 
     def copy(self) -> Pads:
         other = Pads(self.capacity)
@@ -40,7 +49,7 @@ class Pads:
     def _cap(self, si: int) -> int:
         return self.capacity[si] if si < len(self.capacity) else 1
 
-    def _after(self, si: int, t: float) -> list[tuple[float, float, str]]:
+    def _after(self, si: int, t: float) -> list[Reservation]:
         """Resource ``si``'s reservations less those that surely end before
         ``t`` (they start too early to last until then)."""
         slots = self.slots.get(si, _NONE)
@@ -102,7 +111,7 @@ class Pads:
             return None  # later starts are shorter still
         cap = self._cap(si)
         slots = self._after(si, t_from)
-        if cap == 1:
+        if cap == 1:  # as in ``earliest``, for a window shrinking towards ``t_max``
             t = t_from
             uid, from_s = ign if ign is not None else ("", float("inf"))
             from_s -= EPS_S
@@ -170,8 +179,13 @@ class Pads:
         self.longest[si] = max(self.longest.get(si, 0.0), end_s - start_s)
         insort(self.by_uav.setdefault(uav_id, []), (start_s, end_s, si))
 
+    def book(self, bookings: Iterable[Booking], uav_id: str) -> None:
+        """Add ``uav_id``'s ``bookings``."""
+        for b in bookings:
+            self.add(b.resource, b.start_s, b.end_s, uav_id)
 
-def _busy(slots: list[tuple[float, float, str]], t_from: float, ign: Ignore) -> list:
+
+def _busy(slots: list[Reservation], t_from: float, ign: Ignore) -> list[tuple[float, float]]:
     """``(start, end)`` of the reservations ending after ``t_from``, leaving
     out those ``ign`` names."""
     lo = t_from + EPS_S

@@ -21,7 +21,8 @@ from ground_station.planner.energy import (
 )
 from ground_station.planner.model import Vec3
 from ground_station.planner.pads import Ignore, Pads
-from ground_station.planner.state import State
+from ground_station.planner.result import Step
+from ground_station.planner.state import Booking, State
 
 PAD_WAIT_S = 300.0
 """A recharge that waits longer than this for a pad makes us try every station."""
@@ -31,6 +32,11 @@ late (far above rounding error and ``EPS_S``), so no station is tried."""
 
 
 class RcOption(NamedTuple):
+    """A recharge detour: at charging station ``si``, after a wait of
+    ``wait_s`` for a pad, charging ``dur_s`` from ``e_before`` to
+    ``e_charged`` Wh; the target is then reached at ``arrive_task`` with
+    ``e_at_task`` Wh."""
+
     si: int
     wait_s: float
     dur_s: float
@@ -91,7 +97,11 @@ def _rc_best(
     stations: list[int],
     best: RcOption | None = None,
 ) -> RcOption | None:
-    """``best`` or the first option at ``stations`` that beats it."""
+    """``best`` or the first option at ``stations`` that beats it.
+
+    One loop over the stations kept whole: it runs for every recharge
+    considered (the planner's hottest loop after ``advance``), and a helper
+    call per station would cost more than its body."""
     t, pos, e, _landed, _ = st
     speed, wh_per_m, capacity = k.speed_mps, k.wh_per_m, k.capacity_wh
     floor_wh = k.reserve_wh - EPS_WH
@@ -140,7 +150,9 @@ def _rc_best(
     return best
 
 
-def emit_recharge(k: Kin, site: Site, st: State, rc: RcOption, steps: list, res: list) -> State:
+def emit_recharge(
+    k: Kin, site: Site, st: State, rc: RcOption, steps: list[Step], res: list[Booking]
+) -> State:
     """Append the flight to the pad (landing to wait for a free pad if needed)
     and the recharge; returns the state on the pad."""
     t, pos, _e, _landed, tool = st
@@ -149,11 +161,33 @@ def emit_recharge(k: Kin, site: Site, st: State, rc: RcOption, steps: list, res:
     d1 = site.dists(pos)[rc.si]
     arr = t + d1 / k.speed_mps
     if rc.wait_s > EPS_S:
-        steps.append(("wait", t, arr, arr + rc.wait_s, rc.e_before, sp, None, None, None, None, d1))
-        t, arr, d1 = arr + rc.wait_s, arr + rc.wait_s, 0.0
+        end = arr + rc.wait_s
+        steps.append(
+            Step(
+                kind="wait",
+                start_s=t,
+                arrive_s=arr,
+                end_s=end,
+                energy_after_wh=rc.e_before,
+                position_m=sp,
+                distance_m=d1,
+            )
+        )
+        t, arr, d1 = end, end, 0.0
     end = arr + rc.dur_s
-    steps.append(("recharge", t, arr, end, rc.e_charged, sp, None, None, station.id, None, d1))
-    res.append((rc.si, arr, end))
+    steps.append(
+        Step(
+            kind="recharge",
+            start_s=t,
+            arrive_s=arr,
+            end_s=end,
+            energy_after_wh=rc.e_charged,
+            position_m=sp,
+            distance_m=d1,
+            station=station.id,
+        )
+    )
+    res.append(Booking(rc.si, arr, end))
     return State(end, sp, rc.e_charged, True, tool)
 
 

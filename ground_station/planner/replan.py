@@ -20,9 +20,16 @@ from ground_station.planner.errors import PlanningProblemError
 from ground_station.planner.export import export
 from ground_station.planner.load import check_problem
 from ground_station.planner.model import Action, InspectAction, MonitorAction, Problem, Uav, Vec3
-from ground_station.planner.removal import remove_in_place
+from ground_station.planner.removal import remove
 from ground_station.planner.result import Plan
-from ground_station.planner.routes import Ctx, Options, Route, emergency_landing, queue_order
+from ground_station.planner.routes import (
+    Ctx,
+    Grounded,
+    Options,
+    Route,
+    emergency_landing,
+    queue_order,
+)
 from ground_station.planner.simulate import State, Task, simulate
 
 replace = msgspec.structs.replace
@@ -118,9 +125,9 @@ class Session:
         displaced: list[str] = []
         for uid in ctx.placed_uavs(aid):
             mine = lambda t: t.action_id == aid  # noqa: E731
-            if ctx.remove_tasks(uid, mine) is None and remove_in_place(ctx, uid, mine) is None:
+            if not remove(ctx, uid, mine):
                 displaced.extend(sorted(ctx.remove_displacing(uid, mine)))
-        ctx.pinned = {p for p in ctx.pinned if p[0] != aid}
+        ctx.pinned = {(a, i) for a, i in ctx.pinned if a != aid}
         ctx.unplaced.pop(aid, None)
         for other in dict.fromkeys(displaced):
             self._strip(other)
@@ -265,16 +272,11 @@ class Session:
                 dropped.setdefault(t.action_id, []).append(t)
             r.tasks = []
             ctx.reinit(uid, init)
-        ctx.pinned = {p for p in ctx.pinned if p[0] not in dropped}
+        ctx.pinned = {(a, i) for a, i in ctx.pinned if a not in dropped}
         for aid, lost in dropped.items():
             a = ctx.actions[aid]
             if isinstance(a, MonitorAction):
-                gaps = [
-                    (t.anchor_s, t.index, t.anchor_s + t.service_s)
-                    for t in lost
-                    if t.anchor_s is not None and t.index is not None
-                ]
-                if monitor.repair(ctx, a, gaps):
+                if monitor.repair(ctx, a, monitor.segment_needs(lost)):
                     continue
                 self._strip(aid)
             self._pending.append(aid)
@@ -287,7 +289,7 @@ class Session:
         if landing is None:
             return False
         self._drop_route(uid)
-        self.ctx.emergency[uid] = (landing, init, r.kin)
+        self.ctx.emergency[uid] = Grounded(landing, init, r.kin)
         return True
 
     def _uav_lost(self, uid: str) -> None:
@@ -310,19 +312,15 @@ class Session:
             if t.kind == "inspect" and t.index is not None:
                 lost[t.action_id].append(t.index)
             ctx.pinned.discard((t.action_id, t.index))
-        gaps: dict[str, list[tuple[float, int, float]]] = {}
-        for t in r.tasks:
-            if t.kind == "monitor" and t.anchor_s is not None and t.index is not None:
-                gaps.setdefault(t.action_id, []).append(
-                    (t.anchor_s, t.index, t.anchor_s + t.service_s)
-                )
         for aid, idx in lost.items():
             a = ctx.actions[aid]
             if aid in self._pending:
                 continue  # displaced meanwhile: re-planned whole by _flush
             if isinstance(a, InspectAction):
                 heuristic.place_inspect(ctx, a, idx)
-            elif isinstance(a, MonitorAction) and monitor.repair(ctx, a, gaps.get(aid, [])):
+            elif isinstance(a, MonitorAction) and monitor.repair(
+                ctx, a, monitor.segment_needs(t for t in r.tasks if t.action_id == aid)
+            ):
                 continue
             else:
                 self._strip(aid)
@@ -342,7 +340,7 @@ class Session:
         if landing is not None:
             if u.id in ctx.routes:
                 self._drop_route(u.id)
-            ctx.emergency[u.id] = (landing, init, kin)
+            ctx.emergency[u.id] = Grounded(landing, init, kin)
         elif u.id in ctx.routes:
             if not ctx.reinit(u.id, init):
                 self._shed(u.id, init)

@@ -10,6 +10,9 @@ import random
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from math import dist
+from typing import NamedTuple
+
+import msgspec
 
 from ground_station.planner.energy import Kin, Site
 from ground_station.planner.model import (
@@ -20,7 +23,7 @@ from ground_station.planner.model import (
     Problem,
 )
 from ground_station.planner.pads import Pads
-from ground_station.planner.result import Unplaced
+from ground_station.planner.result import Step, Unplaced
 from ground_station.planner.simulate import Sim, State, Task, simulate
 
 
@@ -48,6 +51,15 @@ class Options:
     before local search; None chooses by instance size."""
 
 
+class GapCache(NamedTuple):
+    """Insertion positions worth trying in a route (``insertion.gap_positions``),
+    valid while its task list is ``tasks`` and ``anywhere`` is unchanged."""
+
+    tasks: list[Task]
+    anywhere: bool
+    positions: list[int]
+
+
 class Route:
     """A UAV's tasks and their simulation (steps exclude the final home leg)."""
 
@@ -58,15 +70,41 @@ class Route:
         self.init = init
         self.tasks: list[Task] = []
         self.states: list[State] = []
-        self.steps: list = []
+        self.steps: list[Step] = []
         self.marks: list[int] = []
-        self.gap_cache: tuple | None = None  # (tasks list, anywhere, positions)
+        self.gap_cache: GapCache | None = None
 
     def state_before(self, pos: int) -> State:
         return self.states[pos - 1] if pos > 0 else self.init
 
     def tail(self) -> State:
         return self.states[-1] if self.states else self.init
+
+
+class RouteState(msgspec.Struct, frozen=True, gc=False):
+    """A route's lists at a snapshot (they are replaced, never mutated)."""
+
+    init: State
+    tasks: list[Task]
+    states: list[State]
+    steps: list[Step]
+    marks: list[int]
+
+
+class Snapshot(NamedTuple):
+    """A planning state to roll back to (``Ctx.snapshot``)."""
+
+    routes: dict[str, RouteState]
+    pads: Pads
+    unplaced: dict[str, list[Unplaced]]
+
+
+class Grounded(NamedTuple):
+    """A UAV in a battery fault: it lands at ``station_id`` from ``state``."""
+
+    station_id: str
+    state: State
+    kin: Kin
 
 
 @dataclass
@@ -86,20 +124,25 @@ class Ctx:
     anywhere: bool = False  # improvement: also insert between any two actions
     fast: bool = False  # replanning: fewer alternatives per placement
     rng: random.Random | None = None  # improvement: randomised placement choices
-    emergency: dict[str, tuple[str, State, Kin]] = field(default_factory=dict)
+    emergency: dict[str, Grounded] = field(default_factory=dict)
     last_fail: Task | None = None  # the task that made the last removal fail
 
     # -- drafts -----------------------------------------------------------
-    def snapshot(self) -> tuple:
-        routes = {u: (r.init, r.tasks, r.states, r.steps, r.marks) for u, r in self.routes.items()}
+    def snapshot(self) -> Snapshot:
+        routes = {
+            u: RouteState(r.init, r.tasks, r.states, r.steps, r.marks)
+            for u, r in self.routes.items()
+        }
         unplaced = {a: list(v) for a, v in self.unplaced.items()}
-        return routes, self.pads.copy(), unplaced
+        return Snapshot(routes, self.pads.copy(), unplaced)
 
     def restore(self, snap: tuple) -> None:
+        """Go back to ``snap``, a ``Snapshot`` (callers may keep it as a plain tuple)."""
         routes, pads, unplaced = snap
-        for u, (init, tasks, states, steps, marks) in routes.items():
+        for u, saved in routes.items():
             r = self.routes[u]
-            r.init, r.tasks, r.states, r.steps, r.marks = init, tasks, states, steps, marks
+            r.init, r.tasks, r.states = saved.init, saved.tasks, saved.states
+            r.steps, r.marks = saved.steps, saved.marks
         self.pads = pads.copy()
         self.unplaced = {a: list(v) for a, v in unplaced.items()}
 
@@ -164,8 +207,7 @@ class Ctx:
             )
             r.steps = r.steps[:base] + sim.steps + r.steps[old_base:]
             self.pads.remove_uav(uid, st.t, conv_t)
-        for si, s, e in sim.res:
-            self.pads.add(si, s, e, uid)
+        self.pads.book(sim.res, uid)
 
     def remove_tasks(self, uid: str, pred: Callable[[Task], bool]) -> list[Task] | None:
         """Remove matching tasks and re-simulate; None (unchanged) if infeasible."""
@@ -251,7 +293,7 @@ def emergency_landing(problem: Problem, kin: Kin, st: State, site: Site) -> str 
     """The station to land at if the UAV cannot reach any station above the
     reserve (a battery fault); None if it can plan normally (including a UAV
     on a charging station, which just recharges first)."""
-    if site.charging and site.nearest(st.pos)[0] < 1e-9:
+    if site.charging and site.nearest(st.pos).distance_m < 1e-9:
         return None
     best = min(problem.stations, key=lambda s: dist(s.position_m, st.pos), default=None)
     if best is None:
@@ -263,9 +305,8 @@ def emergency_landing(problem: Problem, kin: Kin, st: State, site: Site) -> str 
 
 def queue_order(actions: list[Action] | tuple[Action, ...]) -> list[Action]:
     """The paper's FCFS-by-weight queue: heavier first, then release, then input order."""
-    return [
-        a for _, a in sorted(enumerate(actions), key=lambda p: (-p[1].weight, p[1].release_s, p[0]))
-    ]
+    order = sorted(range(len(actions)), key=lambda i: (-actions[i].weight, actions[i].release_s, i))
+    return [actions[i] for i in order]
 
 
 def new_ctx(problem: Problem, options: Options) -> Ctx:
@@ -274,7 +315,7 @@ def new_ctx(problem: Problem, options: Options) -> Ctx:
     types = {t.id: t for t in problem.uav_types}
     actions = {a.id: a for a in problem.actions}
     routes: dict[str, Route] = {}
-    emergency = {}
+    emergency: dict[str, Grounded] = {}
     for u in problem.uavs:
         if not u.available:
             continue
@@ -282,7 +323,7 @@ def new_ctx(problem: Problem, options: Options) -> Ctx:
         init = State(problem.now_s, u.position_m, u.energy_wh, not u.airborne, u.tool)
         landing = emergency_landing(problem, kin, init, site)
         if landing is not None:
-            emergency[u.id] = (landing, init, kin)
+            emergency[u.id] = Grounded(landing, init, kin)
         else:
             routes[u.id] = Route(kin, init)
     pads = Pads([s.pads for s in site.charging])

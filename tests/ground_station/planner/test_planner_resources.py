@@ -72,10 +72,11 @@ def test_time_preserving_removal_keeps_other_steps_in_time() -> None:
     ctx = build(problem)
     uid, route = max(ctx.routes.items(), key=lambda kv: len(kv[1].tasks))
     victim = route.tasks[0].action_id
-    kept_before = [s for s in route.steps if s[6] not in (None, victim)]
+    kept_before = [s for s in route.steps if s.action_id not in (None, victim)]
     assert remove_in_place(ctx, uid, lambda t: t.action_id == victim) is not None
-    kept_after = [s for s in ctx.routes[uid].steps if s[6] is not None]
-    assert [(s[0], s[2], s[3]) for s in kept_after] == [(s[0], s[2], s[3]) for s in kept_before]
+    kept_after = [s for s in ctx.routes[uid].steps if s.action_id is not None]
+    times_after = [(s.kind, s.arrive_s, s.end_s) for s in kept_after]
+    assert times_after == [(s.kind, s.arrive_s, s.end_s) for s in kept_before]
     # Remove the victim everywhere and check the whole plan still validates.
     for other in ctx.placed_uavs(victim):
         assert remove_in_place(ctx, other, lambda t: t.action_id == victim) is not None
