@@ -24,6 +24,8 @@ import enum
 import time
 from collections.abc import Callable, Mapping
 
+import msgspec
+
 from proto.plan import Plan
 from proto.rpc import UavOpState, UavState
 from proto.telemetry import (
@@ -49,6 +51,8 @@ TRAFFIC_MAX_AGE_S = 60.0
 """UAVs last heard airborne longer ago than this are left out of the
 traffic (a hung UAV may hover on where it was for that long)."""
 AIRBORNE = frozenset({FlightState.TAKING_OFF, FlightState.FLYING, FlightState.LANDING})
+FALLEN = frozenset({UavOpState.FAILED, UavOpState.LOST})
+"""States in which a UAV's last word of holding off for another is shown no more."""
 SILENT_AFTER_S = 2.0
 """Silence (s) after which a present UAV is silent: ten telemetry periods, and
 two status periods (an agent with no position yet is heard once a second)."""
@@ -250,12 +254,16 @@ class FleetMonitor:
             )
             silent = silence is not None
             plan = plans.get(uav_id)
+            state = self.state(uav_id)
+            status = uav.status
+            if status is not None and status.holding_for and state in FALLEN:
+                status = msgspec.structs.replace(status, holding_for=None)
             out.append(
                 UavState(
                     uav_id=uav_id,
-                    state=self.state(uav_id),
+                    state=state,
                     telemetry=uav.telemetry,
-                    status=uav.status,
+                    status=status,
                     silent_s=round(silence, 1) if silence is not None else None,
                     silent_since_s=uav.silent_since if silent else None,
                     unknown_tasks=unknown_tasks(plan, uav.status) if silent and plan else [],

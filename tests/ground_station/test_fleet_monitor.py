@@ -92,6 +92,23 @@ def test_states_follow_the_agent_and_crashes():
     assert monitor.state("u1") == UavOpState.FAILED
 
 
+def test_a_fallen_uav_is_shown_holding_off_for_nobody():
+    """An agent's last status said it held off for another UAV; once its
+    vehicle crashed that is no longer so (the operator saw "failed, holding
+    off for uav-1")."""
+    monitor = FleetMonitor(["u1"], 5.0)
+    present(monitor, "u1", 0.0)
+    monitor.check(0.0)
+    busy = AgentStatus(uav_id="u1", stamp_s=0, state=AgentState.BUSY, holding_for="u2")
+    monitor.on_status(busy)
+    [row] = monitor.snapshot({})
+    assert row.status is not None and row.status.holding_for == "u2"
+    monitor.on_telemetry(telemetry("u1", FlightState.CRASHED), 1.0)
+    [row] = monitor.snapshot({})
+    assert row.state == UavOpState.FAILED
+    assert row.status is not None and row.status.holding_for is None
+
+
 def test_unknown_uavs_are_ignored():
     monitor = FleetMonitor(["u1"], 5.0)
     monitor.on_token("intruder", True, 0.0)
