@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import math
 
+from ground_station import planner as pl
 from ground_station.fleet_monitor import FleetMonitor
 from ground_station.planning import UavNow, capacity_wh, home_station
 from proto.plan import DeliverTask, GoHomeTask, MonitorTask, Plan, Task
@@ -46,7 +47,7 @@ def uavs_now(
                 available=monitor.available(spec.id) and spec.id not in controlled,
                 airborne=bool(telemetry and telemetry.flight_state in AIRBORNE),
                 tool=monitor.tool(spec.id),
-                running_action=running_action(monitor, plans.get(spec.id), in_force),
+                running=running_task(monitor, plans.get(spec.id), in_force),
             )
         )
     return uavs
@@ -66,15 +67,19 @@ def reported_task(monitor: FleetMonitor, plan: Plan | None, in_force: set[str]) 
     return None
 
 
-def running_action(monitor: FleetMonitor, plan: Plan | None, in_force: set[str]) -> str | None:
-    """The monitoring action in force the UAV of ``plan`` is executing, or the
-    delivery whose tool it holds, if any."""
+def running_task(
+    monitor: FleetMonitor, plan: Plan | None, in_force: set[str]
+) -> pl.RunningTask | None:
+    """The monitoring segment of an action in force the UAV of ``plan`` is
+    flying (its slot: the planner keeps the UAV on it), or the delivery whose
+    tool it holds, if any."""
     task = reported_task(monitor, plan, in_force)
-    if task is None or plan is None:
+    if task is None or plan is None or task.action_id is None:
         return None
-    holds_tool = monitor.tool(plan.uav_id) == getattr(task, "tool", None)
-    if isinstance(task, MonitorTask) or (isinstance(task, DeliverTask) and holds_tool):
-        return task.action_id
+    if isinstance(task, MonitorTask):
+        return pl.RunningTask(action_id=task.action_id, index=task.slot)
+    if isinstance(task, DeliverTask) and monitor.tool(plan.uav_id) == task.tool:
+        return pl.RunningTask(action_id=task.action_id)
     return None
 
 

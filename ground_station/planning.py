@@ -38,7 +38,9 @@ class UavNow:
     available: bool
     airborne: bool = False
     tool: str | None = None
-    running_action: str | None = None
+    running: pl.RunningTask | None = None
+    """The monitoring segment it flies (its action and slot), or the delivery
+    whose tool it holds."""
 
 
 PLANNING_MARGIN = 0.05
@@ -160,7 +162,7 @@ def build_problem(
                 tool=u.tool,
                 available=u.available,
                 airborne=u.airborne,
-                running=pl.RunningTask(action_id=u.running_action) if u.running_action else None,
+                running=u.running,
             )
             for u in uavs
         ),

@@ -69,8 +69,9 @@ class RunningTask(msgspec.Struct, frozen=True, kw_only=True):
 
     inspect: servicing waypoint ``index`` with ``remaining_s`` left (kept on
     this UAV, first in its plan). deliver: the UAV holds the tool (kept, the
-    drop is first in its plan). monitor: the UAV holds slot ``index``; it is
-    preferred for that action (J3 continuation bonus).
+    drop is first in its plan). monitor: the UAV holds slot ``index``; it goes on
+    there first, takes no other slot before, and is preferred for that
+    action (J3 continuation bonus).
     """
 
     action_id: str

@@ -9,6 +9,7 @@ to leave, another UAV arrives at or before that moment and takes the slot
 at their start time; the UAV that left recharges in its own route.
 A start promised by an earlier plan stands unless one ``EARLIER_S``
 sooner is possible now.
+A UAV flying a segment (``Uav.running``) goes on at its slot first.
 An action some of whose segments stay planned (an improvement ruins the
 rest but never moves a frozen one) gets only its slots without one.
 """
@@ -173,14 +174,21 @@ def _cover_needs(
     heapq.heapify(need)
     end = max(n.end_s for n in needs)
     fleet = _members(ctx, a, uids)
+    held = _held_slots(ctx, a)
     suit_sum = 0.0
     handovers = 0
     moved: set[str] = set()
     while need:
         cur = heapq.heappop(need)
         t, end = cur.start_s, cur.end_s
-        pre = _rank_uavs(ctx, fleet, slots[cur.slot], t, push)
+        holders = {uid: slot for uid, slot in held.items() if uid not in moved}
+        pre = [
+            r
+            for r in _rank_uavs(ctx, fleet, slots[cur.slot], t, push)
+            if holders.get(r[1], cur.slot) == cur.slot
+        ]
         offers = _offers(ctx, a, pre, cur, slots[cur.slot], ready, moved)
+        offers.sort(key=lambda o: o.uid not in holders)  # the UAV on the slot goes on first
         taken = _commit_first(ctx, a, offers, cur, slots[cur.slot])
         if taken is None:
             return None
@@ -193,6 +201,17 @@ def _cover_needs(
     return (
         w.suitability_s * suit_sum + w.travel * (end - ctx.problem.now_s) * a.k + 10.0 * handovers
     )
+
+
+def _held_slots(ctx: Ctx, a: MonitorAction) -> dict[str, int]:
+    """The slot of ``a`` each UAV flying one of its segments holds now: it
+    goes on watching there first, and takes no other slot before that (never
+    flown across the ring while a newcomer takes its place)."""
+    return {
+        u.id: u.running.index
+        for u in ctx.problem.uavs
+        if u.running is not None and u.running.action_id == a.id and u.id in ctx.routes
+    }
 
 
 def _offers(

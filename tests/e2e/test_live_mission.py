@@ -5,6 +5,7 @@ refused, a UAV killed mid-monitor replaced. Every process is real; x10."""
 
 from __future__ import annotations
 
+import itertools
 import math
 
 import msgspec
@@ -136,6 +137,49 @@ def test_a_uav_killed_mid_monitor_is_declared_lost_and_another_takes_the_slot(tr
     after = [s for s in truth.samples if s.sim_s > killed_at]
     others = set().union(*(truth.watching(s, W2, 4.0, SAFETY.monitor_height_m) for s in after))
     assert others - {victim}, "another UAV took the slot after the kill"
+
+
+def test_a_k2_watcher_that_falls_leaves_the_other_on_its_slot_and_its_seconds_counted(truth):
+    """Motors fail on one of two UAVs watching W2 (the other has deliveries
+    to make after it): the other goes on watching
+    from where it is (never flown across the ring to the fallen one's slot),
+    a newcomer takes the free slot, and the seconds already watched stay
+    counted: the action's progress never falls back, and it ends about when
+    what was left of it is flown."""
+    duration_s = 180.0
+    watch = truth.submit(monitor("W2", 2, duration_s))["action_id"]
+    for tool, station, worker in (("wrench", "tp-wrench", "W1"), ("hammer", "tp-hammer", "W3")):
+        body = {"tool": tool, "tool_station_id": station, "worker_id": worker}
+        truth.submit({"type": "deliver", **body})  # for uav-1, the one with a gripper
+    progress: list[float] = []
+
+    def watched_for(seconds: float) -> bool:
+        progress.append(truth.action(watch)["progress"])
+        return progress[-1] * duration_s >= seconds
+
+    truth.until("both watch W2 for 60 s", lambda: watched_for(60.0), 120)
+    sample = truth.samples[-1]
+    pair = sorted(truth.watching(sample, W2, 4.0, SAFETY.monitor_height_m))
+    assert len(pair) == 2, pair
+    survivor = "uav-1" if "uav-1" in pair else pair[0]  # the one with deliveries to come
+    [victim] = set(pair) - {survivor}
+    kept = _xyz(_at(sample, survivor))
+    truth.gateway.call("POST", "/v1/sim/faults", json={"type": "motor", "uav_id": victim})
+    fell_at, left_s = sample.sim_s, (1.0 - progress[-1]) * duration_s
+    truth.until("the monitor ends", lambda: watched_for(duration_s) or truth.finished(watch), 150)
+    assert truth.action(watch)["state"] == "completed", truth.action(watch)
+    assert all(b >= a - 0.01 for a, b in itertools.pairwise(progress)), progress
+    ended_at = truth.samples[-1].sim_s
+    assert ended_at - fell_at <= left_s + 120.0, (fell_at, left_s, ended_at)
+    on_ring = [
+        s
+        for s in truth.samples
+        if s.sim_s > fell_at and survivor in truth.watching(s, W2, 4.0, SAFETY.monitor_height_m)
+    ]
+    assert on_ring, "the survivor went on watching"
+    moved = max(math.dist(_xyz(_at(s, survivor)), kept) for s in on_ring)
+    assert moved < 1.5, f"{survivor} moved {moved:.1f} m along the ring"
+    assert not truth.violations(*UNSAFE)
 
 
 def test_work_asked_while_the_autopilots_warm_up_waits_for_them_then_flies(tmp_path):
