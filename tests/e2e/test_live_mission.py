@@ -143,9 +143,10 @@ def test_a_k2_watcher_that_falls_leaves_the_other_on_its_slot_and_its_seconds_co
     """Motors fail on one of two UAVs watching W2 (the other has deliveries
     to make after it): the other goes on watching
     from where it is (never flown across the ring to the fallen one's slot),
-    a newcomer takes the free slot, and the seconds already watched stay
-    counted: the action's progress never falls back, and it ends about when
-    what was left of it is flown."""
+    a newcomer takes the free slot, and the survivor's seconds stay
+    counted: the action's progress falls back by at most the fallen UAV's
+    share (a UAV's seconds count when its segment ends, and a loss voids
+    them), and it ends about when what was left of it is flown."""
     duration_s = 180.0
     watch = truth.submit(monitor("W2", 2, duration_s))["action_id"]
     for tool, station, worker in (("wrench", "tp-wrench", "W1"), ("hammer", "tp-hammer", "W3")):
@@ -165,10 +166,12 @@ def test_a_k2_watcher_that_falls_leaves_the_other_on_its_slot_and_its_seconds_co
     [victim] = set(pair) - {survivor}
     kept = _xyz(_at(sample, survivor))
     truth.gateway.call("POST", "/v1/sim/faults", json={"type": "motor", "uav_id": victim})
-    fell_at, left_s = sample.sim_s, (1.0 - progress[-1]) * duration_s
+    fell_at, at_fall = sample.sim_s, progress[-1]
+    left_s = (1.0 - at_fall) * duration_s
     truth.until("the monitor ends", lambda: watched_for(duration_s) or truth.finished(watch), 150)
     assert truth.action(watch)["state"] == "completed", truth.action(watch)
-    assert all(b >= a - 0.01 for a, b in itertools.pairwise(progress)), progress
+    fall_back = max((a - b for a, b in itertools.pairwise(progress)), default=0.0)
+    assert fall_back <= at_fall / 2 + 0.02, progress  # at most the fallen UAV's share
     ended_at = truth.samples[-1].sim_s
     assert ended_at - fell_at <= left_s + 120.0, (fell_at, left_s, ended_at)
     on_ring = [
