@@ -71,6 +71,7 @@ def next_leg(
     traffic: Iterable[Point] = (),
     ahead: Iterable[Point] = (),
     climbers: Iterable[Point] = (),
+    movers: Iterable[Point] = (),
 ) -> Point:
     """The point to send the autopilot now on the way from ``here`` to
     ``target``; with ``cruise_z`` the flight is legged anyway and crosses
@@ -92,7 +93,15 @@ def next_leg(
     leaving the slot its relief flies to) is not. ``climbers`` are where
     UAVs climbing straight up are (those whose climb targets this UAV does
     not cross over): a leg across one's column within its height band waits,
-    holding where the UAV is, until it has climbed clear (:func:`_across`)."""
+    holding where the UAV is, until it has climbed clear (:func:`_across`).
+    ``movers`` are where UAVs after this one in id order are heard on their
+    way: a climb or descent that would pass one holds where the UAV is
+    (:func:`_vertical`); that UAV sees this one in its way and moves clear
+    itself, so of two only one sidesteps (chaos seed 18: two sidestepping
+    each other at once chose one point and met 0.97 m apart)."""
+    if math.hypot(target.x_m - here.x_m, target.y_m - here.y_m) <= TOLERANCE_M:
+        leg = _vertical(here, target, target, traffic, movers)  # straight up or down
+        return _across(here, leg, climbers, clear_m)
     low = min(here.z_m, target.z_m)
 
     def near(points: Iterable[Point]) -> list[Point]:
@@ -123,11 +132,9 @@ def next_leg(
         crossing = own_level(crossing, *layer)  # over something: at a level of its own
     elif layer is not None and here.z_m > needed + TOLERANCE_M:
         crossing = level_below(here.z_m, needed, *layer)  # higher than needed: its own, below
-    if math.hypot(target.x_m - here.x_m, target.y_m - here.y_m) <= TOLERANCE_M:
-        return _sidestep(here, target, traffic, target.z_m) or target  # straight up or down
     if here.z_m < crossing - TOLERANCE_M:
         up = Point(x_m=here.x_m, y_m=here.y_m, z_m=crossing)
-        return _sidestep(here, target, traffic, crossing) or up
+        return _vertical(here, up, target, traffic, movers)
     return _across(here, Point(x_m=target.x_m, y_m=target.y_m, z_m=crossing), climbers, clear_m)
 
 
@@ -144,21 +151,36 @@ def _across(here: Point, leg: Point, climbers: Iterable[Point], clear_m: float) 
     return leg
 
 
-def _sidestep(here: Point, target: Point, obstacles: Iterable[Point], to_z: float) -> Point | None:
-    """Where to move level first, if going up or down at ``here`` to
-    ``to_z`` would pass within ``SIDESTEP_M`` (horizontally) of an obstacle
-    on the way (from the UAV's height to 1 m past ``to_z``): ``SIDESTEP_M``
-    from the nearest such, away from it (right below or above it: towards
-    the target)."""
+def _vertical(
+    here: Point, to: Point, target: Point, obstacles: Iterable[Point], movers: Iterable[Point]
+) -> Point:
+    """The leg up or down from ``here`` to ``to`` (right above or below it)
+    on the way to ``target``: ``to``, or where the UAV is while a mover is
+    in the way (:func:`_in_way`), or first level clear of an obstacle in
+    the way (:func:`_sidestep`)."""
+    if _in_way(here, to.z_m, movers):
+        return here
+    blocking = _in_way(here, to.z_m, obstacles)
+    return _sidestep(here, target, blocking) if blocking else to
+
+
+def _in_way(here: Point, to_z: float, points: Iterable[Point]) -> list[Point]:
+    """The ``points`` a climb or descent at ``here`` to ``to_z`` would pass
+    within ``SIDESTEP_M`` of (horizontally), from the UAV's height to 1 m
+    past ``to_z``."""
     up = to_z > here.z_m
     low, high = (here.z_m, to_z + 1.0) if up else (to_z - 1.0, here.z_m)
-    blocking = [
+    return [
         p
-        for p in obstacles
+        for p in points
         if ground_distance(p, here, here) < SIDESTEP_M - TOLERANCE_M and low < p.z_m < high
     ]
-    if not blocking:
-        return None
+
+
+def _sidestep(here: Point, target: Point, blocking: list[Point]) -> Point:
+    """Where to move level first, clear of the ``blocking`` obstacles of a
+    climb or descent: ``SIDESTEP_M`` from the nearest, away from it (right
+    below or above it: towards the target)."""
     p = min(blocking, key=lambda b: ground_distance(b, here, here))
     dx, dy = here.x_m - p.x_m, here.y_m - p.y_m
     if math.hypot(dx, dy) < TOLERANCE_M:

@@ -176,6 +176,23 @@ class Traffic:
             and horizontal_distance(s.where, heard[s.uav_id]) < HOVER_M
         ]
 
+    def movers(self, now_s: float) -> list[Point]:
+        """Where the UAVs after this one in id order are heard on their way
+        (not hovering): this UAV holds rather than climb or descend past one
+        (:func:`onboard_agent.route.next_leg`); each sees this one in its
+        way (:meth:`obstacles`) and moves clear of it."""
+        others = self._others(now_s)
+        flying_to = {s.uav_id for s in others if s.target}
+        return [
+            s.where
+            for s in others
+            if not s.target
+            and not s.unheard
+            and not s.hovering
+            and s.uav_id > self.uav_id
+            and s.uav_id in flying_to
+        ]
+
     def _tracks(
         self, others: list[Sighting], heard: dict[str, Point], track: tuple[Point, Point] | None
     ) -> list[Point]:

@@ -176,6 +176,7 @@ class GoNear(AgentBehaviour):
         layer = ctx.spots.layer
         ahead = ctx.traffic.ahead(ctx.link_clock(), track)
         climbers = ctx.traffic.climbers(ctx.link_clock())
+        movers = ctx.traffic.movers(ctx.link_clock())
         leg = route.next_leg(
             vehicle.position,
             point,
@@ -187,6 +188,7 @@ class GoNear(AgentBehaviour):
             traffic,
             ahead,
             climbers,
+            movers,
         )
         moved = self._sent is None or self._sent.distance_to(leg) > config.follow_threshold_m
         if moved or now - self._sent_at >= config.goto_resend_s:

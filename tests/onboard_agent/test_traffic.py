@@ -6,7 +6,8 @@ from __future__ import annotations
 import msgspec
 import pytest
 
-from onboard_agent.route import next_leg
+from onboard_agent.route import SIDESTEP_M, next_leg
+from onboard_agent.surroundings import horizontal_distance
 from onboard_agent.traffic import Traffic
 from proto.geo import Point
 from proto.telemetry import Traffic as TrafficReport
@@ -230,3 +231,42 @@ def test_a_uav_waits_to_cross_the_column_of_a_later_one_climbing_through_its_hei
     later.update(TrafficReport(uavs=[uav1_climbing]), 0.0)
     assert later.climbers(0.0) == []  # never waits for one before it (it crosses over its climb)
     assert p(-1, 20, 17) in later.obstacles(0.0)
+
+
+def test_of_two_uavs_climbing_and_descending_past_each_other_only_the_later_moves_aside():
+    """Chaos seed 18: uav-1 climbing out of C2's spot (1, 20) and uav-2
+    coming down to a waypoint 1.4 m beside it sidestepped each other at
+    once, to one point, and met 0.97 m apart. uav-1 holds while uav-2,
+    on its way, is in its climb; uav-2 sees uav-1 in its descent and moves
+    clear of it; once uav-2 hovers there, uav-1 moves aside itself."""
+    one_at, one_to = p(1.0, 20.0, 10.0), p(1.0, 20.0, 17.0)
+    two_at, two_to = p(0.0, 21.0, 12.4), p(0.0, 21.0, 3.0)
+
+    def seen_by(uav_id: str, other: TrafficEntry) -> Traffic:
+        traffic = Traffic(uav_id)
+        traffic.update(TrafficReport(uavs=[other]), 0.0)
+        return traffic
+
+    def leg(traffic: Traffic, here: Point, target: Point) -> Point:
+        obstacles = traffic.obstacles(0.0, (here, target))
+        return next_leg(
+            here,
+            target,
+            obstacles,
+            2.5,
+            layer=(0, 3),
+            traffic=obstacles,
+            movers=traffic.movers(0.0),
+        )
+
+    two = TrafficEntry(uav_id="uav-2", position=two_at, airborne=True, target=two_to)
+    one = TrafficEntry(uav_id="uav-1", position=one_at, airborne=True, target=one_to)
+    assert leg(seen_by("uav-1", two), one_at, one_to) == one_at  # holds
+    aside = leg(seen_by("uav-2", one), two_at, two_to)
+    assert aside.z_m == two_at.z_m and horizontal_distance(aside, one_at) >= SIDESTEP_M
+    assert seen_by("uav-2", one).movers(0.0) == []  # never holds for one before it
+    hovering = msgspec.structs.replace(two, target=two_at)
+    beside = leg(seen_by("uav-1", hovering), one_at, one_to)
+    assert beside.z_m == one_at.z_m and horizontal_distance(beside, two_at) >= SIDESTEP_M
+    far = msgspec.structs.replace(two, position=p(6.0, 21.0, 12.4), target=p(6.0, 21.0, 3.0))
+    assert leg(seen_by("uav-1", far), one_at, one_to) == one_to  # none in the way: climbs
