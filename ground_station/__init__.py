@@ -2,4 +2,4 @@
 the planner (``ground_station.planner``, a pure library), the fleet monitor,
 the durable SQLite store and the operator REST gateway
 (``ground_station.gateway``). The Zenoh router process is
-``linecrew.bus.router``."""
+``linecrew_runtime.bus.router``."""

@@ -4,8 +4,8 @@ from __future__ import annotations
 
 import dataclasses
 
-from linecrew.clock import wall_period_s
-from linecrew.settings import EnvSettings
+from linecrew_runtime.clock import wall_period_s
+from linecrew_runtime.settings import EnvSettings
 
 
 @dataclasses.dataclass(frozen=True, kw_only=True)

@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 from ground_station.fleet_monitor import Change, FleetMonitor
-from linecrew.clock import time_of_day
+from linecrew_runtime.clock import time_of_day
 from proto.events import EventKind
 
 KINDS = {

@@ -9,10 +9,10 @@ import sys
 from ground_station.config import GsConfig
 from ground_station.service import GroundStation
 from ground_station.store import StoreUnavailable
-from linecrew.bus import Bus
-from linecrew.clock import mission_clock
-from linecrew.process import Shutdown, common_parser, start
-from linecrew.scenarios import ScenarioError, load
+from linecrew_runtime.bus import Bus
+from linecrew_runtime.clock import mission_clock
+from linecrew_runtime.process import Shutdown, common_parser, start
+from linecrew_runtime.scenarios import ScenarioError, load
 from proto.errors import Unavailable
 
 log = logging.getLogger("linecrew.ground_station")

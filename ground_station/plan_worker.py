@@ -23,13 +23,12 @@ from __future__ import annotations
 import asyncio
 import dataclasses
 import logging
-from typing import TYPE_CHECKING
+from typing import Protocol
 
+from ground_station.replan_jobs import Computed, Job
+from ground_station.replanner import Replanner
 from ground_station.store import StoreUnavailable
-
-if TYPE_CHECKING:
-    from ground_station.missions import MissionManager
-    from ground_station.replan_jobs import Computed
+from proto.plan import Plan
 
 log = logging.getLogger(__name__)
 
@@ -47,11 +46,26 @@ class WorkerStats:
     max_batch: int = 0
 
 
+class Planned(Protocol):
+    """What the worker plans for (the mission manager): a replan's or an
+    improvement's inputs taken on the loop, its result committed there."""
+
+    replanner: Replanner
+
+    def prepare_replan(self, reason: str) -> Job: ...
+
+    def prepare_improvement(self) -> Job: ...
+
+    def finish_replan(self, computed: Computed) -> list[Plan] | None: ...
+
+    def finish_improvement(self, computed: Computed | None, interrupted: bool = False) -> None: ...
+
+
 class PlanWorker:
     """Coalescing trigger + one planning worker for a mission manager."""
 
     def __init__(
-        self, manager: MissionManager, *, improve: bool = True, improve_delay_s: float = 0.5
+        self, manager: Planned, *, improve: bool = True, improve_delay_s: float = 0.5
     ) -> None:
         self.manager = manager
         self.improve = improve

@@ -27,8 +27,8 @@ from ground_station.missions import MissionManager
 from ground_station.replan_jobs import ImproveSettings
 from ground_station.replanner import Replanner
 from ground_station.store import Store
-from linecrew.bus import Bus
-from linecrew.process import Shutdown
+from linecrew_runtime.bus import Bus
+from linecrew_runtime.process import Shutdown
 from proto.errors import Forbidden
 from proto.keys import KeySpace, Role, UavTopic
 from proto.rpc import (

@@ -1,2 +1,3 @@
-"""Process plumbing shared by every linecrew process: the Zenoh bus layer,
-structured logging, signal handling and the ``linecrew`` console script."""
+"""The operator's tools, on the top floor: the ``linecrew`` console script,
+its client commands, launchers (up, demo, compose), chaos runs, benchmarks
+and reports. The processes' shared runtime is :mod:`linecrew_runtime`."""

@@ -18,13 +18,13 @@ from collections.abc import Iterator
 
 # name -> ("module:function", help). The function takes argv and returns an exit code.
 COMMANDS: dict[str, tuple[str, str]] = {
-    "router": ("linecrew.bus.router:main", "run the ground site's Zenoh router"),
+    "router": ("linecrew_runtime.bus.router:main", "run the ground site's Zenoh router"),
     "ground-station": ("ground_station.main:main", "run the mission manager and planner"),
     "sim": ("sim_fleet.main:main", "run the MAVLink fleet simulator and human tracker"),
     "agent": ("onboard_agent.main:main", "run one UAV's onboard agent (or: agent tree)"),
     "agents": ("onboard_agent.fleet_host:main", "simulation only: many UAVs' agents, one process"),
     "gateway": ("ground_station.gateway.main:main", "run the operator REST API"),
-    "health": ("linecrew.health:main", "is a process's liveliness token up (healthchecks)"),
+    "health": ("linecrew_runtime.health:main", "is a process's liveliness token up (healthchecks)"),
     "up": ("linecrew.launch.up:main", "run router, ground station, gateway, sim and agents"),
     "demo": ("linecrew.launch.demo:main", "the paper's scenario end to end"),
     "chaos": ("linecrew.chaos.main:main", "seeded partitions, kills, faults on a local fleet"),

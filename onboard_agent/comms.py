@@ -14,7 +14,7 @@ import asyncio
 import logging
 from collections.abc import Callable
 
-from linecrew.bus import Bus
+from linecrew_runtime.bus import Bus
 from onboard_agent.agent import Agent
 from onboard_agent.mission import PlanVerdict
 from proto.errors import LinecrewError

@@ -3,15 +3,15 @@
 Values come from defaults, then ``LINECREW_AGENT_*`` environment variables
 (the upper-cased field name, e.g. ``LINECREW_AGENT_TICK_HZ=5``), then
 command-line overrides, read as every process reads its settings
-(:mod:`linecrew.settings`).
+(:mod:`linecrew_runtime.settings`).
 """
 
 from __future__ import annotations
 
 import dataclasses
 
-from linecrew.clock import wall_period_s
-from linecrew.settings import EnvSettings
+from linecrew_runtime.clock import wall_period_s
+from linecrew_runtime.settings import EnvSettings
 
 
 @dataclasses.dataclass(frozen=True, kw_only=True)

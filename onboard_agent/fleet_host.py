@@ -24,8 +24,8 @@ import logging
 import sys
 from collections.abc import Awaitable, Callable
 
-from linecrew.bus import BusConfig
-from linecrew.process import Shutdown, common_parser, start
+from linecrew_runtime.bus import BusConfig
+from linecrew_runtime.process import Shutdown, common_parser, start
 from onboard_agent.agent import UnknownUav
 from onboard_agent.config import AgentConfig
 from onboard_agent.main import add_flight_arguments, settings

@@ -13,9 +13,9 @@ import asyncio
 import logging
 import sys
 
-from linecrew import scenarios
-from linecrew.mavlink_keys import load_key
-from linecrew.process import Shutdown, common_parser, start
+from linecrew_runtime import scenarios
+from linecrew_runtime.mavlink_keys import load_key
+from linecrew_runtime.process import Shutdown, common_parser, start
 from onboard_agent import export
 from onboard_agent.config import AgentConfig
 from onboard_agent.runtime import run_agent

@@ -9,8 +9,8 @@ import logging
 import time
 from collections.abc import Awaitable
 
-from linecrew.bus import Bus, BusConfig
-from linecrew.clock import mission_clock
+from linecrew_runtime.bus import Bus, BusConfig
+from linecrew_runtime.clock import mission_clock
 from onboard_agent.agent import Agent
 from onboard_agent.autopilot.link import MavlinkLink
 from onboard_agent.comms import Comms

@@ -38,8 +38,8 @@ they never reach an HTTP answer:
 
     PlanningProblemError  "planning_problem_invalid"    ground_station.planner (ValueError)
     DevTokenRefused       "dev_token_refused"           ground_station.gateway (ValueError)
-    SigningKeyError       "signing_key_invalid"         linecrew.mavlink_keys (ValueError)
-    ScenarioError         "invalid_scenario"            linecrew.scenarios
+    SigningKeyError       "signing_key_invalid"         linecrew_runtime.mavlink_keys (ValueError)
+    ScenarioError         "invalid_scenario"            linecrew_runtime.scenarios
     StartError            "start_failed"                linecrew.launch.supervisor
     SecureProfileError    "secure_profile_unavailable"  linecrew.launch.secure
     NetnsError            "netns_unavailable"           linecrew.chaos.netns (RuntimeError)

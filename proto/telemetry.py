@@ -1,7 +1,7 @@
 """What agents and the human tracker report: telemetry, agent status,
 task outcomes and human poses. Times (``stamp_s``) are mission seconds:
 UNIX seconds in the field, UNIX seconds times K in a simulation run at
-``--speedup K`` (:mod:`linecrew.clock`), for every sender alike.
+``--speedup K`` (:mod:`linecrew_runtime.clock`), for every sender alike.
 """
 
 from __future__ import annotations

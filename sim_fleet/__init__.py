@@ -17,11 +17,12 @@ from sim_fleet.events import Outcome, Result, Severity, StatusText
 from sim_fleet.fleet import Fleet, FleetConfig, FleetThread
 from sim_fleet.geo import GeoFrame
 from sim_fleet.modes import FlightState, Mode
+from sim_fleet.params import AutopilotParams
 from sim_fleet.rules import InteractionRules
 from sim_fleet.safety import Violation
 from sim_fleet.streams import TelemetryRates
 from sim_fleet.tools import Delivery, Drop
-from sim_fleet.vehicle import AutopilotParams, Vehicle
+from sim_fleet.vehicle import Vehicle
 from sim_fleet.world import World
 
 __all__ = [

@@ -5,9 +5,9 @@ from __future__ import annotations
 import argparse
 import sys
 
-from linecrew.bus import Bus, BusConfig
-from linecrew.fault_kinds import add_fault_arguments, fault_from_args
-from linecrew.process import site_id
+from linecrew_runtime.bus import Bus, BusConfig
+from linecrew_runtime.fault_kinds import add_fault_arguments, fault_from_args
+from linecrew_runtime.process import site_id
 from proto import errors
 from proto.keys import KeySpace
 from proto.sim import FaultApplied

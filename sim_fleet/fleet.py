@@ -30,8 +30,8 @@ from typing import TypeVar
 
 from proto.scenario import Scenario
 from sim_fleet.mavlink_endpoint import Addr, VehicleEndpoint
+from sim_fleet.params import AutopilotParams
 from sim_fleet.streams import TelemetryRates
-from sim_fleet.vehicle import AutopilotParams
 from sim_fleet.world import World
 
 log = logging.getLogger(__name__)

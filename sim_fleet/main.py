@@ -13,22 +13,22 @@ import asyncio
 import logging
 import sys
 
-from linecrew.bus import Bus
-from linecrew.clock import mission_clock
-from linecrew.mavlink_keys import SigningKeyError, key_path, load_key
-from linecrew.process import Shutdown, common_parser, start
-from linecrew.scenarios import ScenarioError, load
+from linecrew_runtime.bus import Bus
+from linecrew_runtime.clock import mission_clock
+from linecrew_runtime.mavlink_keys import SigningKeyError, key_path, load_key
+from linecrew_runtime.process import Shutdown, common_parser, start
+from linecrew_runtime.scenarios import ScenarioError, load
 from proto.errors import Unavailable
 from proto.keys import KeySpace, Role
 from proto.scenario import Scenario
 from proto.sim import GetSimState, SimFault
 from sim_fleet.faults import apply_fault
 from sim_fleet.fleet import Fleet, FleetConfig
+from sim_fleet.params import AutopilotParams
 from sim_fleet.spot_control import SpotControl, SpotService
 from sim_fleet.streams import TelemetryRates
 from sim_fleet.tracker import HumanTracker
 from sim_fleet.truth import sim_state
-from sim_fleet.vehicle import AutopilotParams
 
 log = logging.getLogger("linecrew.sim")
 

@@ -43,7 +43,7 @@ from typing import Any, cast
 os.environ["MAVLINK20"] = "1"  # for any mavutil user in this process; we use the v20 dialect
 from pymavlink.dialects.v20 import ardupilotmega as mav
 
-from linecrew.mavlink_keys import signing_timestamp
+from linecrew_runtime.mavlink_keys import signing_timestamp
 from sim_fleet import autopilot, frames, mavlink_telemetry, streams
 from sim_fleet.auto_mission import AutoMission
 from sim_fleet.events import Outcome, Result, Severity

@@ -13,16 +13,40 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
 from sim_fleet.battery import CELLS, NOMINAL_CELL_V
+from sim_fleet.modes import Mode
 
 if TYPE_CHECKING:
     from proto.fleet import UavType
-    from sim_fleet.vehicle import AutopilotParams
 
 # MAV_PARAM_TYPE
 INT8 = 2
 INT16 = 4
 INT32 = 6
 REAL32 = 9
+
+
+@dataclass(frozen=True, kw_only=True)
+class AutopilotParams:
+    """ArduCopter-like parameters shared by all simulated vehicles."""
+
+    rtl_alt_m: float = 15.0  # RTL_ALT
+    land_final_alt_m: float = 2.0  # below this LAND descends at land_speed_mps
+    land_speed_mps: float = 0.5  # LAND_SPEED
+    accel_mps2: float = 2.0  # horizontal and vertical acceleration limit
+    arm_min_soc: float = 0.25  # pre-arm: below this state of charge arming fails
+    low_soc: float = 0.20  # "Battery 1 is low" warning
+    critical_soc: float = 0.10  # "Battery 1 is critical" warning
+    auto_disarm_s: float | None = 10.0  # DISARM_DELAY: armed on the ground, not flying
+    initial_mode: Mode = Mode.STABILIZE
+    # GPS/EKF warm-up after power-on, in simulated seconds (ArduCopter SITL takes
+    # ~40 s): the GPS gets its 3-D fix half-way, then the EKF uses it, sets its
+    # origin and home; until then arming fails with ArduCopter's pre-arm texts
+    # and positions read lat = lon = 0. 0 skips it (an explicit choice).
+    warmup_s: float = 3.0
+
+    def __post_init__(self) -> None:
+        if self.warmup_s < 0:
+            raise ValueError("warmup_s must be >= 0")
 
 
 @dataclass(slots=True)

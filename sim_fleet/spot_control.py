@@ -18,7 +18,7 @@ import logging
 import time
 from collections.abc import Iterable
 
-from linecrew.bus import Bus
+from linecrew_runtime.bus import Bus
 from proto.keys import KeySpace, UavTopic
 from proto.spots import SpotClaim, StationSpots
 from sim_fleet.physics import Vec3, horizontal_distance

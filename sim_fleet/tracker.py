@@ -7,7 +7,7 @@ import asyncio
 import time
 from collections.abc import Callable
 
-from linecrew.bus import Bus
+from linecrew_runtime.bus import Bus
 from proto.geo import Point, SiteFrame
 from proto.keys import KeySpace
 from proto.site import Site

@@ -10,7 +10,6 @@ from __future__ import annotations
 import logging
 import math
 from collections.abc import Callable
-from dataclasses import dataclass
 
 from proto.fleet import UavSpec, UavType
 from proto.site import Tool
@@ -18,7 +17,7 @@ from sim_fleet import physics
 from sim_fleet.battery import Battery
 from sim_fleet.events import Severity, StatusText
 from sim_fleet.modes import FlightState, Mode
-from sim_fleet.params import ParamStore, vehicle_parameters
+from sim_fleet.params import AutopilotParams, ParamStore, vehicle_parameters
 from sim_fleet.physics import Vec3
 from sim_fleet.terrain import flat
 
@@ -27,30 +26,6 @@ log = logging.getLogger(__name__)
 MOVING_MPS = 0.2  # above this speed a UAV draws flight power, below it hover power
 VELOCITY_TIMEOUT_S = 3.0  # GUIDED velocity commands expire (ArduCopter GUID_TIMEOUT)
 AIRBORNE = frozenset({FlightState.TAKING_OFF, FlightState.FLYING, FlightState.LANDING})
-
-
-@dataclass(frozen=True, kw_only=True)
-class AutopilotParams:
-    """ArduCopter-like parameters shared by all simulated vehicles."""
-
-    rtl_alt_m: float = 15.0  # RTL_ALT
-    land_final_alt_m: float = 2.0  # below this LAND descends at land_speed_mps
-    land_speed_mps: float = 0.5  # LAND_SPEED
-    accel_mps2: float = 2.0  # horizontal and vertical acceleration limit
-    arm_min_soc: float = 0.25  # pre-arm: below this state of charge arming fails
-    low_soc: float = 0.20  # "Battery 1 is low" warning
-    critical_soc: float = 0.10  # "Battery 1 is critical" warning
-    auto_disarm_s: float | None = 10.0  # DISARM_DELAY: armed on the ground, not flying
-    initial_mode: Mode = Mode.STABILIZE
-    # GPS/EKF warm-up after power-on, in simulated seconds (ArduCopter SITL takes
-    # ~40 s): the GPS gets its 3-D fix half-way, then the EKF uses it, sets its
-    # origin and home; until then arming fails with ArduCopter's pre-arm texts
-    # and positions read lat = lon = 0. 0 skips it (an explicit choice).
-    warmup_s: float = 3.0
-
-    def __post_init__(self) -> None:
-        if self.warmup_s < 0:
-            raise ValueError("warmup_s must be >= 0")
 
 
 class Vehicle:

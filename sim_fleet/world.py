@@ -23,6 +23,7 @@ from sim_fleet import physics
 from sim_fleet.events import Severity
 from sim_fleet.geo import GeoFrame, vec
 from sim_fleet.modes import FlightState
+from sim_fleet.params import AutopilotParams
 from sim_fleet.physics import Vec3
 from sim_fleet.recorder import FlightRecorder
 from sim_fleet.rules import InteractionRules
@@ -30,7 +31,7 @@ from sim_fleet.safety import SEPARATION, SafetyMonitor, Violation
 from sim_fleet.stations import ChargingStation
 from sim_fleet.terrain import Ground
 from sim_fleet.tools import Delivery, Drop, ToolStation, station_in_reach, worker_in_reach
-from sim_fleet.vehicle import AutopilotParams, Vehicle
+from sim_fleet.vehicle import Vehicle
 from sim_fleet.watch import WatchLog
 
 log = logging.getLogger(__name__)

@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import pytest
 
-from linecrew.bus import BusConfig
+from linecrew_runtime.bus import BusConfig
 from tests.support.processes import free_port, port_open, router_args, running
 
 

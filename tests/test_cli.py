@@ -70,7 +70,7 @@ def test_submit_inspect_takes_points_with_a_negative_first_coordinate(capsys, mo
 
 # -- --json anywhere, help texts ------------------------------------------------------
 
-PAPER_YAML = pathlib.Path(__file__).parents[1] / "linecrew" / "scenarios" / "paper.yaml"
+PAPER_YAML = pathlib.Path(__file__).parents[1] / "linecrew_runtime" / "scenarios" / "paper.yaml"
 
 
 def cli(*args: str, env: dict | None = None, cwd=None) -> subprocess.CompletedProcess:
@@ -213,4 +213,4 @@ def test_plan_of_a_file_of_neither_format_names_both_and_their_examples(tmp_path
     [line] = done.stderr.splitlines()
     assert "planning problem" in line and "scenario" in line
     assert "ground_station/planner/examples/paper.yaml" in line
-    assert "linecrew/scenarios/paper.yaml" in line
+    assert "linecrew_runtime/scenarios/paper.yaml" in line

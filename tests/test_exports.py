@@ -8,7 +8,7 @@ import pytest
 
 PACKAGES = [
     "proto",
-    "linecrew.bus",
+    "linecrew_runtime.bus",
     "ground_station.store",
     "ground_station.gateway",
     "ground_station.planner",

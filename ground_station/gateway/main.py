@@ -14,10 +14,10 @@ from ground_station.gateway.gestures import Vocabulary
 from ground_station.gateway.rpc import GsClient
 from ground_station.gateway.settings import GatewaySettings, check_token, resolve_token
 from ground_station.gateway.workers import WorkerPoses
-from linecrew.bus import Bus
-from linecrew.clock import mission_clock
-from linecrew.process import common_parser, start
-from linecrew.scenarios import ScenarioError, load
+from linecrew_runtime.bus import Bus
+from linecrew_runtime.clock import mission_clock
+from linecrew_runtime.process import common_parser, start
+from linecrew_runtime.scenarios import ScenarioError, load
 from proto.errors import Unavailable
 from proto.keys import KeySpace, Role
 from proto.telemetry import HumanPose

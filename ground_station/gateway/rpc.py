@@ -7,7 +7,7 @@ from typing import Any
 
 import msgspec
 
-from linecrew.bus import Bus
+from linecrew_runtime.bus import Bus
 from proto.keys import KeySpace, Role
 from proto.rpc import Reply, Request
 from proto.sim import FaultApplied, SimFault

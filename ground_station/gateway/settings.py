@@ -7,7 +7,7 @@ import os
 import pathlib
 import secrets
 
-from linecrew.settings import NOT_FROM_ENV, EnvSettings
+from linecrew_runtime.settings import NOT_FROM_ENV, EnvSettings
 from proto.errors import LinecrewError
 
 

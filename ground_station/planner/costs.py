@@ -10,7 +10,7 @@ from __future__ import annotations
 
 from math import dist
 
-from ground_station.planner.model import CostWeights, Vec3
+from ground_station.planner.model import CostWeights, RunningTask, Vec3
 from ground_station.planner.simulate import State
 
 
@@ -19,9 +19,9 @@ def j1(caps: dict[str, float], kind: str) -> float:
     return caps.get(kind, float("inf"))
 
 
-def j3(running_action: str | None, action_id: str) -> float:
+def j3(running: RunningTask | None, action_id: str) -> float:
     """Interruption term: -1 for continuing the action the UAV is running."""
-    return -1.0 if running_action == action_id else 0.0
+    return -1.0 if running is not None and running.action_id == action_id else 0.0
 
 
 def j3_interrupt(running_weight: float, new_weight: float) -> float:

@@ -207,11 +207,7 @@ def _held_slots(ctx: Ctx, a: MonitorAction) -> dict[str, int]:
     """The slot of ``a`` each UAV flying one of its segments holds now: it
     goes on watching there first, and takes no other slot before that (never
     flown across the ring while a newcomer takes its place)."""
-    return {
-        u.id: u.running.index
-        for u in ctx.problem.uavs
-        if u.running is not None and u.running.action_id == a.id and u.id in ctx.routes
-    }
+    return {uid: run.index for uid, run in ctx.running.items() if run.action_id == a.id}
 
 
 def _offers(

@@ -21,6 +21,7 @@ from ground_station.planner.model import (
     DeliverAction,
     InspectAction,
     Problem,
+    RunningTask,
 )
 from ground_station.planner.pads import Pads
 from ground_station.planner.result import Step, Unplaced
@@ -119,7 +120,7 @@ class Ctx:
     actions: dict[str, Action]
     weights: CostWeights
     unplaced: dict[str, list[Unplaced]] = field(default_factory=dict)
-    running: dict[str, str] = field(default_factory=dict)
+    running: dict[str, RunningTask] = field(default_factory=dict)  # by UAV, in routes
     pinned: set[tuple[str, int | None]] = field(default_factory=set)
     anywhere: bool = False  # improvement: also insert between any two actions
     fast: bool = False  # replanning: fewer alternatives per placement
@@ -338,7 +339,7 @@ def new_ctx(problem: Problem, options: Options) -> Ctx:
         if run is None or u.id not in routes:
             continue
         act = actions[run.action_id]
-        ctx.running[u.id] = act.id
+        ctx.running[u.id] = run
         task = None
         if isinstance(act, InspectAction):
             wp = act.waypoints[run.index]

@@ -20,10 +20,10 @@ import threading
 import time
 
 from linecrew.bench.child import wait_ready
-from linecrew.bus.config import BusConfig
-from linecrew.bus.router_process import router_process
-from linecrew.bus.session import Bus
-from linecrew.latency import summary_ms
+from linecrew_runtime.bus.config import BusConfig
+from linecrew_runtime.bus.router_process import router_process
+from linecrew_runtime.bus.session import Bus
+from linecrew_runtime.latency import summary_ms
 from proto import (
     GeoPoint,
     GetHistory,

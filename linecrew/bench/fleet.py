@@ -35,12 +35,12 @@ import time
 import msgspec
 
 from linecrew.bench.ground_station import random_inspection
-from linecrew.latency import summary_ms
 from linecrew.launch.local_run import LocalRun, RunOptions
 from linecrew.launch.proc_stats import KINDS, measure
 from linecrew.launch.supervisor import StartError
-from linecrew.logs import configure_logging
-from linecrew.scenarios import load, with_fleet_size
+from linecrew_runtime.latency import summary_ms
+from linecrew_runtime.logs import configure_logging
+from linecrew_runtime.scenarios import load, with_fleet_size
 from proto import AgentStatus, EventKind, GetHistory, GsEvent, HistoryReply, Plan, UavTopic
 from proto.errors import LinecrewError
 

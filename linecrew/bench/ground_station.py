@@ -35,10 +35,10 @@ import msgspec
 from linecrew.bench.child import wait_ready
 from linecrew.bench.light_agent import LightAgent
 from linecrew.bench.plan_stability import EventWatch, measure_stability, settle
-from linecrew.bus import Bus, BusConfig
-from linecrew.bus.router_process import router_process
-from linecrew.latency import percentile_ms
-from linecrew.scenarios import load, with_fleet_size
+from linecrew_runtime.bus import Bus, BusConfig
+from linecrew_runtime.bus.router_process import router_process
+from linecrew_runtime.latency import percentile_ms
+from linecrew_runtime.scenarios import load, with_fleet_size
 from proto import (
     ActionList,
     ActionReply,

@@ -9,7 +9,7 @@ import threading
 import time
 
 from ground_station.planning import capacity_wh, home_station
-from linecrew.bus import Bus, BusConfig
+from linecrew_runtime.bus import Bus, BusConfig
 from proto import FlightState, GeoPoint, KeySpace, Plan, Role, Scenario, Telemetry
 
 

@@ -32,7 +32,7 @@ from ground_station.replanner import Replanner
 from ground_station.store import Store
 from linecrew.bench.ground_station import random_inspection
 from linecrew.planner_tools.cli import deadline
-from linecrew.scenarios import load, with_fleet_size
+from linecrew_runtime.scenarios import load, with_fleet_size
 from proto import FlightState, GeoPoint, Scenario, SubmitAction, Telemetry
 
 NOW_S = 100.0

@@ -9,8 +9,8 @@ import threading
 import time
 from collections.abc import Callable
 
-from linecrew.bus import Bus
 from linecrew.launch.proc_stats import cpu_s
+from linecrew_runtime.bus import Bus
 from proto import EventKind, GetMetrics, GsEvent, KeySpace, MetricsReply
 
 

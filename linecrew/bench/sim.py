@@ -13,7 +13,7 @@ import socket
 import threading
 import time
 
-from linecrew.scenarios import load, with_fleet_size
+from linecrew_runtime.scenarios import load, with_fleet_size
 from sim_fleet.fleet import Fleet, FleetConfig, FleetThread
 from sim_fleet.streams import TelemetryRates
 

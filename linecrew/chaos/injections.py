@@ -44,8 +44,8 @@ from linecrew.chaos.faults import ProcessFaults
 from linecrew.chaos.invariants import Checker, Violation
 from linecrew.chaos.netns_run import NetnsRun
 from linecrew.chaos.schedule import Injection
-from linecrew.clock import OFFSET_ENV
 from linecrew.launch.local_run import LocalRun
+from linecrew_runtime.clock import OFFSET_ENV
 from proto import GetSimState, SimState
 from proto.errors import LinecrewError
 

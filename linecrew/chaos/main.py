@@ -19,9 +19,9 @@ from linecrew.chaos.report import render
 from linecrew.chaos.runner import ChaosOptions, ChaosRunner
 from linecrew.chaos.schedule import make_schedule
 from linecrew.launch.supervisor import StartError
-from linecrew.logs import configure_logging
-from linecrew.process import Shutdown
-from linecrew.scenarios import ScenarioError, load
+from linecrew_runtime.logs import configure_logging
+from linecrew_runtime.process import Shutdown
+from linecrew_runtime.scenarios import ScenarioError, load
 
 
 def main(argv: list[str] | None = None) -> int:

@@ -33,12 +33,12 @@ import socket
 import httpx
 import msgspec
 
-from linecrew.bus import Bus, BusConfig
 from linecrew.chaos.netns import Network, network
 from linecrew.client import session
 from linecrew.client.gateway import http_client
 from linecrew.launch.local_run import RunOptions
 from linecrew.launch.supervisor import Supervisor
+from linecrew_runtime.bus import Bus, BusConfig
 from proto.keys import KeySpace, Role
 from proto.scenario import Scenario
 
@@ -126,7 +126,7 @@ class NetnsRun:
         self.url = f"http://{self.address('gateway')}:{GATEWAY_PORT}"
         token_file = self.run_dir / "token"
         site = ["--site", self.keys.site]
-        sup.start("router", "linecrew.bus.router", "--listen", self.endpoint, *site, *lease)
+        sup.start("router", "linecrew_runtime.bus.router", "--listen", self.endpoint, *site, *lease)
         self._wait("router")
         self.bus = Bus.open(BusConfig(connect=(self.endpoint,), lease_ms=opts.lease_ms))
         db = ["--db", str(self.run_dir / "gs.db")]

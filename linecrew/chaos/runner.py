@@ -32,7 +32,7 @@ from linecrew.chaos.netns_run import NetnsRun
 from linecrew.chaos.schedule import CUTS, Injection, make_schedule
 from linecrew.chaos.timeline import Timeline
 from linecrew.launch.local_run import LocalRun, RunOptions
-from linecrew.process import Shutdown
+from linecrew_runtime.process import Shutdown
 from proto import GetHistory, GetSimState, HistoryReply, SimState
 from proto.errors import LinecrewError
 from proto.scenario import Scenario

@@ -25,7 +25,7 @@ from linecrew.client.render import (
     plan_timeline,
 )
 from linecrew.client.session import NoRunError, Target, resolve
-from linecrew.fault_kinds import add_fault_arguments, fault_from_args
+from linecrew_runtime.fault_kinds import add_fault_arguments, fault_from_args
 from proto.rpc import Command
 
 GLOBAL_VALUED = ("--url", "--token")
@@ -231,7 +231,7 @@ def plan_main(argv: list[str]) -> int:
     parser.epilog = (
         "offline: linecrew plan FILE [-o PLAN.json] [--improve-ms N] [--mode complete|paper]; "
         "FILE is a planning problem (example: ground_station/planner/examples/paper.yaml) or a "
-        "scenario (example: linecrew/scenarios/paper.yaml); "
+        "scenario (example: linecrew_runtime/scenarios/paper.yaml); "
         "linecrew plan --validate PROBLEM PLAN checks a plan."
     )
     parser.add_argument(

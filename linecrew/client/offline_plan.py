@@ -4,7 +4,7 @@ A *planning problem* is the planner's own format (stations, ``uav_types``,
 ``uavs`` with positions and energy, ``actions`` with a ``kind``; example:
 ``ground_station/planner/examples/paper.yaml``). A *scenario* is what
 ``linecrew up`` / ``demo`` run (``site``, ``fleet``, scripted ``actions``;
-example: ``linecrew/scenarios/paper.yaml``): it is planned as the ground
+example: ``linecrew_runtime/scenarios/paper.yaml``): it is planned as the ground
 station would at the start of the mission, every UAV on its home station
 with a full battery, each scripted action released at its ``at_s``.
 Everything after FILE goes to the planner (``-o``, ``--improve-ms``,
@@ -22,12 +22,12 @@ import msgspec
 import yaml
 
 import ground_station.planner as planner_pkg
-import linecrew.scenarios as scenarios_pkg
+import linecrew_runtime.scenarios as scenarios_pkg
 from ground_station.planner.errors import PlanningProblemError
 from ground_station.planner.load import problem_from_obj
 from ground_station.planning import UavNow, build_problem, home_station
 from linecrew.planner_tools.cli import plan_main as planner_main
-from linecrew.scenarios import ScenarioError, load
+from linecrew_runtime.scenarios import ScenarioError, load
 from proto.mission import ActionRecord, ActionState
 from proto.scenario import Scenario
 

@@ -7,8 +7,8 @@ from typing import Any
 from rich.table import Table
 from rich.text import Text
 
-from linecrew.clock import time_of_day
 from linecrew.planner_tools.gantt import GLYPH
+from linecrew_runtime.clock import time_of_day
 
 
 def actions_table(records: list[dict[str, Any]]) -> Table:

@@ -2,7 +2,7 @@
 starting anything.
 
 Checks, in order: the YAML (or JSON) syntax; the document against the
-scenario types and its references (:func:`linecrew.scenarios.parse`, as
+scenario types and its references (:func:`linecrew_runtime.scenarios.parse`, as
 every process of a run loads it); fields no type knows (a misspelt field is
 otherwise ignored and its default used); each scripted action as the
 ground station would check it on submission (site, fleet, safety, tool
@@ -25,7 +25,7 @@ import yaml
 
 from ground_station.inventory import reserve
 from ground_station.validation import validate
-from linecrew.scenarios import ScenarioError, parse
+from linecrew_runtime.scenarios import ScenarioError, parse
 from proto.errors import RequestError
 from proto.mission import ActionRecord, ActionState, DeliverAction
 from proto.scenario import Scenario
@@ -207,7 +207,7 @@ def main(argv: list[str]) -> int:
     parser = argparse.ArgumentParser(
         prog="linecrew scenario",
         description="Scenario files. check FILE: validate one without starting a fleet "
-        "(example: linecrew/scenarios/paper.yaml).",
+        "(example: linecrew_runtime/scenarios/paper.yaml).",
     )
     parser.add_argument("--json", action="store_true", help="print the result as JSON")
     verbs = parser.add_subparsers(dest="verb", required=True)

@@ -29,9 +29,9 @@ from linecrew.launch.recorder import ExecutionRecorder
 from linecrew.launch.secure import SecureProfileError
 from linecrew.launch.supervisor import StartError
 from linecrew.launch.up import add_run_arguments, options_from, scenario_from
-from linecrew.logs import configure_logging
-from linecrew.process import Shutdown
-from linecrew.scenarios import ScenarioError
+from linecrew_runtime.logs import configure_logging
+from linecrew_runtime.process import Shutdown
+from linecrew_runtime.scenarios import ScenarioError
 from proto import GetSimState, GsEvent, SimState
 from proto.scenario import Scenario
 

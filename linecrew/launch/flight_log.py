@@ -29,7 +29,7 @@ from typing import Any
 
 import msgspec
 
-from linecrew.bus import Bus
+from linecrew_runtime.bus import Bus
 from proto.keys import KeySpace, UavTopic
 from proto.telemetry import AgentStatus, TaskOutcome, Telemetry
 

@@ -25,14 +25,14 @@ from collections.abc import Callable
 import httpx
 import msgspec
 
-from linecrew.bus import Bus, BusConfig
-from linecrew.bus.router_process import free_port, port_open
 from linecrew.client import session
 from linecrew.client.gateway import Gateway, http_client
 from linecrew.launch import secure
 from linecrew.launch.flight_log import FlightLog
 from linecrew.launch.ports import free_udp_block
 from linecrew.launch.supervisor import Child, Supervisor
+from linecrew_runtime.bus import Bus, BusConfig
+from linecrew_runtime.bus.router_process import free_port, port_open
 from proto.errors import LinecrewError
 from proto.keys import KeySpace, Role
 from proto.rpc import FleetReply, GetFleet
@@ -133,7 +133,7 @@ class LocalRun:
 
         router = sup.start(
             "router",
-            "linecrew.bus.router",
+            "linecrew_runtime.bus.router",
             *(["--zenoh-config", profile.router_config()] if profile else []),
             "--listen",
             self.endpoint.replace("localhost", "127.0.0.1"),

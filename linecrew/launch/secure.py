@@ -18,7 +18,7 @@ import shutil
 import subprocess
 import sys
 
-from linecrew.mavlink_keys import key_path
+from linecrew_runtime.mavlink_keys import key_path
 from proto.errors import LinecrewError
 
 GEN = pathlib.Path(__file__).resolve().parents[2] / "deploy" / "tls" / "gen-dev-ca.sh"

@@ -37,7 +37,7 @@ class StartError(LinecrewError):
 
 @dataclasses.dataclass
 class Child:
-    """One supervised process."""
+    """One supervised process (its own session: signals go to its group)."""
 
     name: str
     popen: subprocess.Popen[bytes]
@@ -47,10 +47,38 @@ class Child:
         """Still running."""
         return self.popen.poll() is None
 
+    def output(self) -> str:
+        """Everything it logged so far."""
+        return self.log_path.read_text(errors="replace") if self.log_path.exists() else ""
+
     def tail(self, lines: int = 15) -> str:
         """The end of its log."""
-        text = self.log_path.read_text(errors="replace") if self.log_path.exists() else ""
-        return "\n".join(text.splitlines()[-lines:])
+        return "\n".join(self.output().splitlines()[-lines:])
+
+    def terminate(self) -> None:
+        """SIGTERM its group, if it runs."""
+        if self.alive():
+            with contextlib.suppress(ProcessLookupError):
+                os.killpg(self.popen.pid, signal.SIGTERM)
+
+    def finish(self, timeout_s: float) -> int:
+        """Wait ``timeout_s`` for it to exit, then SIGKILL its group; its exit code."""
+        try:
+            return self.popen.wait(timeout_s)
+        except subprocess.TimeoutExpired:
+            log.warning("%s ignored SIGTERM; killing it", self.name)
+            return self.kill()
+
+    def stop(self, timeout_s: float = 10.0) -> int:
+        """SIGTERM, then SIGKILL after ``timeout_s``; its exit code."""
+        self.terminate()
+        return self.finish(timeout_s)
+
+    def kill(self) -> int:
+        """SIGKILL its group now; its exit code."""
+        with contextlib.suppress(ProcessLookupError):
+            os.killpg(self.popen.pid, signal.SIGKILL)
+        return self.popen.wait()
 
 
 class Supervisor:
@@ -63,13 +91,17 @@ class Supervisor:
     def start(
         self, name: str, module: str, *args: str, env: Mapping[str, str] | None = None
     ) -> Child:
-        """Start ``python -m module args...`` logging to ``run_dir/name.log``,
-        with ``env`` added to this process's environment."""
+        """Start ``python -m module args...`` (see :meth:`run`)."""
+        return self.run(name, [sys.executable, "-m", module, *args], env)
+
+    def run(self, name: str, argv: list[str], env: Mapping[str, str] | None = None) -> Child:
+        """Start ``argv`` logging to ``run_dir/name.log``, with ``env`` added
+        to this process's environment."""
         log_path = self.run_dir / f"{name}.log"
         env = dict(os.environ, **(env or {}), PYTHONUNBUFFERED="1")
         with open(log_path, "wb") as log_file:
             popen = subprocess.Popen(
-                [*self.command_prefix(name), sys.executable, "-m", module, *args],
+                [*self.command_prefix(name), *argv],
                 stdout=log_file,
                 stderr=subprocess.STDOUT,
                 stdin=subprocess.DEVNULL,
@@ -108,15 +140,7 @@ class Supervisor:
     def stop_all(self, timeout_s: float = 10.0) -> None:
         """SIGTERM every child (newest first), then SIGKILL what is left."""
         for child in reversed(self.children):
-            if child.alive():
-                with contextlib.suppress(ProcessLookupError):
-                    os.killpg(child.popen.pid, signal.SIGTERM)
+            child.terminate()
         deadline = time.monotonic() + timeout_s
         for child in reversed(self.children):
-            try:
-                child.popen.wait(max(0.1, deadline - time.monotonic()))
-            except subprocess.TimeoutExpired:
-                log.warning("%s ignored SIGTERM; killing it", child.name)
-                with contextlib.suppress(ProcessLookupError):
-                    os.killpg(child.popen.pid, signal.SIGKILL)
-                child.popen.wait()
+            child.finish(max(0.1, deadline - time.monotonic()))

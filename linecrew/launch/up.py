@@ -15,9 +15,9 @@ import sys
 from linecrew.launch.local_run import LocalRun, RunOptions
 from linecrew.launch.secure import SecureProfileError
 from linecrew.launch.supervisor import StartError
-from linecrew.logs import configure_logging
-from linecrew.process import Shutdown
-from linecrew.scenarios import ScenarioError, builtin_names, load, with_fleet_size
+from linecrew_runtime.logs import configure_logging
+from linecrew_runtime.process import Shutdown
+from linecrew_runtime.scenarios import ScenarioError, builtin_names, load, with_fleet_size
 from proto.events import GsEvent
 from proto.scenario import Scenario
 

@@ -48,7 +48,7 @@ from typing import Any
 os.environ["MAVLINK20"] = "1"  # before importing mavutil: speak MAVLink 2
 from pymavlink import mavutil
 
-from linecrew.mavlink_keys import signing_timestamp
+from linecrew_runtime.mavlink_keys import signing_timestamp
 from onboard_agent.autopilot.errors import CommandDenied, CommandTimeout, LinkLost
 from onboard_agent.autopilot.protocol import VehicleState
 from onboard_agent.autopilot.reports import MODE_NUMBERS, VehicleReports

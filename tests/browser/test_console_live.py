@@ -18,7 +18,7 @@ import msgspec
 import pytest
 
 from linecrew.launch.local_run import LocalRun, RunOptions
-from linecrew.scenarios import load
+from linecrew_runtime.scenarios import load
 from tests.support.processes import wait_until
 
 SPEEDUP = 10.0

@@ -8,7 +8,7 @@ from __future__ import annotations
 import msgspec
 import pytest
 
-from linecrew.fault_kinds import FAULT_KINDS
+from linecrew_runtime.fault_kinds import FAULT_KINDS
 from proto.sim import SimFault
 from tests.fakes.fleet import TOKEN, big_site, fake_app, serving
 

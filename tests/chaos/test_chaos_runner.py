@@ -18,8 +18,8 @@ from linecrew.chaos.netns import NetnsError
 from linecrew.chaos.report import reproduce
 from linecrew.chaos.schedule import DISRUPTIONS
 from linecrew.chaos.timeline import Timeline
-from linecrew.process import Shutdown
-from linecrew.scenarios import load
+from linecrew_runtime.process import Shutdown
+from linecrew_runtime.scenarios import load
 from proto import Point, SafetyViolation, SimState, VehicleTruth, WatchRecord
 
 chaos_main = importlib.import_module("linecrew.chaos.main")  # the package exports main()

@@ -20,10 +20,10 @@ from linecrew.chaos.faults import ProcessFaults
 from linecrew.chaos.injections import Context, cancel, disk, edit
 from linecrew.chaos.report import render
 from linecrew.chaos.schedule import Injection
-from linecrew.clock import OFFSET_ENV, mission_clock
 from linecrew.launch.local_run import LocalRun, RunOptions
-from linecrew.process import Shutdown
-from linecrew.scenarios import load
+from linecrew_runtime.clock import OFFSET_ENV, mission_clock
+from linecrew_runtime.process import Shutdown
+from linecrew_runtime.scenarios import load
 from proto import Role
 from tests.support.processes import wait_until
 

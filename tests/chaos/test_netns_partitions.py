@@ -19,7 +19,7 @@ from linecrew.chaos import Checker, main
 from linecrew.chaos.faults import ProcessFaults
 from linecrew.chaos.netns_run import NetnsRun
 from linecrew.launch.local_run import RunOptions
-from linecrew.scenarios import load
+from linecrew_runtime.scenarios import load
 from proto import EventKind, GetHistory, GetSimState, HistoryReply, SimState
 from proto.keys import Role
 

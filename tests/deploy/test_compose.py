@@ -18,8 +18,8 @@ from rich.console import Console
 
 from linecrew.client.gateway import Gateway
 from linecrew.launch.demo import TERMINAL, run_mission
-from linecrew.process import Shutdown
-from linecrew.scenarios import load
+from linecrew_runtime.process import Shutdown
+from linecrew_runtime.scenarios import load
 from proto.mission import DeliverAction
 from proto.scenario import Scenario
 from tests.deploy.compose import AGENTS, Stack, poll

@@ -24,8 +24,8 @@ from collections.abc import Iterator
 
 import pytest
 
-from linecrew import health
-from linecrew.bus import Bus, BusConfig
+from linecrew_runtime import health
+from linecrew_runtime.bus import Bus, BusConfig
 from proto.errors import RequestTimeout, Unavailable
 from proto.geo import GeoPoint, Point
 from proto.keys import KeySpace, Role, UavTopic
@@ -83,7 +83,7 @@ def endpoint(pki: pathlib.Path) -> Iterator[str]:
     args = [
         sys.executable,
         "-m",
-        "linecrew.bus.router",
+        "linecrew_runtime.bus.router",
         "--listen",
         f"tls/127.0.0.1:{port}",
         "--zenoh-config",

@@ -18,7 +18,7 @@ from schemathesis.specs.openapi.checks import (
 )
 
 from linecrew.launch.local_run import LocalRun, RunOptions
-from linecrew.scenarios import load
+from linecrew_runtime.scenarios import load
 
 EXAMPLES = 60  # per operation and mode (about a minute in all)
 

@@ -14,7 +14,7 @@ import pytest
 from linecrew.chaos.faults import ProcessFaults
 from linecrew.client.gateway import GatewayError
 from linecrew.launch.local_run import LocalRun, RunOptions
-from linecrew.scenarios import load
+from linecrew_runtime.scenarios import load
 from proto import EventKind
 from proto.spots import spot_positions
 from tests.e2e.truth import TruthLog

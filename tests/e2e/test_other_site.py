@@ -10,7 +10,7 @@ import sys
 import msgspec
 import pytest
 
-from linecrew.scenarios import ScenarioError, load
+from linecrew_runtime.scenarios import ScenarioError, load
 
 PAPER = load("paper")
 

@@ -13,8 +13,8 @@ from rich.console import Console
 
 from linecrew.launch.demo import run_mission
 from linecrew.launch.local_run import LocalRun, RunOptions
-from linecrew.process import Shutdown
-from linecrew.scenarios import load
+from linecrew_runtime.process import Shutdown
+from linecrew_runtime.scenarios import load
 from proto import EventKind, GetHistory, GetSimState, HistoryReply, SimState
 
 SPEEDUP = 10.0

@@ -10,9 +10,9 @@ import shutil
 import httpx
 import pytest
 
-from linecrew.bus import Bus, BusConfig
 from linecrew.launch.local_run import LocalRun, RunOptions
 from linecrew.launch.secure import SecureProfileError, prepare
+from linecrew_runtime.bus import Bus, BusConfig
 from tests.e2e.test_paper_mission import PAPER, RESERVE, SPEEDUP, LandingWatch, fly
 from tests.sim_fleet.mavclient import Client, mavlink
 

@@ -13,9 +13,9 @@ import pytest
 
 from ground_station.config import GsConfig
 from ground_station.fleet_monitor import SILENT_AFTER_S
-from linecrew.clock import time_of_day
 from linecrew.launch.local_run import LocalRun, RunOptions
-from linecrew.scenarios import load
+from linecrew_runtime.clock import time_of_day
+from linecrew_runtime.scenarios import load
 from proto import EventKind
 from tests.e2e.truth import TruthLog
 from tests.support.freeze import frozen

@@ -22,7 +22,7 @@ import uvicorn
 
 from ground_station.gateway import GatewaySettings, Vocabulary, create_app
 from ground_station.gateway.workers import WorkerPoses
-from linecrew.bus.router_process import free_port
+from linecrew_runtime.bus.router_process import free_port
 from proto import KeySpace
 from proto.errors import LinecrewError, NotFound
 from proto.events import EventKind, GsEvent

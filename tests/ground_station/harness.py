@@ -13,7 +13,7 @@ from ground_station.missions import MissionManager
 from ground_station.replan_jobs import ImproveSettings
 from ground_station.replanner import Replanner
 from ground_station.store import Store
-from linecrew.scenarios import load
+from linecrew_runtime.scenarios import load
 from proto import (
     FlightState,
     GeoPoint,

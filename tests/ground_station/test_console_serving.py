@@ -16,7 +16,7 @@ import pytest
 
 from ground_station.gateway import console
 from ground_station.gateway.rpc import to_json
-from linecrew.scenarios import load
+from linecrew_runtime.scenarios import load
 from tests.fakes.fleet import TOKEN, fake_app, serving
 
 ROOT = Path(__file__).resolve().parents[2]

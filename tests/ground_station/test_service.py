@@ -15,8 +15,8 @@ import pytest
 
 from ground_station.service import GroundStation
 from linecrew.bench.light_agent import LightAgent
-from linecrew.bus import Bus
-from linecrew.scenarios import load
+from linecrew_runtime.bus import Bus
+from linecrew_runtime.scenarios import load
 from proto import (
     ActionList,
     ActionReply,
@@ -45,7 +45,7 @@ from proto import (
 )
 from proto.errors import LinecrewError
 from proto.rpc import Request
-from tests.support.processes import Process, running, wait_until
+from tests.support.processes import running, start, wait_until
 
 SCENARIO = load("paper")
 KEYS = KeySpace(SCENARIO.site.id)
@@ -281,7 +281,7 @@ def test_kill_9_and_restart_loses_nothing_accepted(router, client, agents, gs, t
     before = {a.uav_id: a.latest().epoch for a in agents.values()}
     gs.kill()
     wait_until(lambda: not gs_alive(client), 10, "ground station gone")
-    restarted = Process(gs_args(router, str(tmp_path / "gs.db")), "gs-restarted")
+    restarted = start(gs_args(router, str(tmp_path / "gs.db")), "gs-restarted")
     try:
         wait_until(lambda: gs_alive(client), 20, "ground station back")
         actions = client.query(KEYS.rpc("list_actions"), ListActions(), ActionList, 5.0)

@@ -5,7 +5,7 @@ again, when they are what its reports say."""
 from __future__ import annotations
 
 from ground_station.fleet_monitor import SILENT_AFTER_S
-from linecrew.clock import time_of_day
+from linecrew_runtime.clock import time_of_day
 from proto import ActionState, AgentState, AgentStatus, EventKind, InspectTask
 from tests.ground_station.harness import ALL
 

@@ -12,7 +12,7 @@ import pytest
 from ground_station.event_log import EventLog
 from ground_station.store import Store, StoreUnavailable
 from linecrew.bench.light_agent import LightAgent
-from linecrew.bus import Bus
+from linecrew_runtime.bus import Bus
 from proto import ActionState, EventKind, GetMetrics, MetricsReply, RequestError
 from tests.ground_station.test_service import (
     KEYS,

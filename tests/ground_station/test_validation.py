@@ -5,7 +5,7 @@ from __future__ import annotations
 import pytest
 
 from ground_station.validation import InvalidAction, validate
-from linecrew.scenarios import load
+from linecrew_runtime.scenarios import load
 from proto import DeliverAction, InspectAction, MonitorAction, Point, WaypointSpec
 
 PAPER = load("paper")

@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 from linecrew.launch.narrate import Narrator, intro, outcome_text
-from linecrew.scenarios import load
+from linecrew_runtime.scenarios import load
 from proto.events import EventKind, GsEvent
 
 ORIGIN_S = 1000.0

@@ -15,7 +15,7 @@ import msgspec
 import pytest
 
 from linecrew.report.data import load_run
-from linecrew.scenarios import load
+from linecrew_runtime.scenarios import load
 from proto import InspectAction, Point, WaypointSpec
 from proto.scenario import ScriptedAction
 

@@ -12,7 +12,7 @@ import sys
 
 import pytest
 
-from linecrew import scenarios
+from linecrew_runtime import scenarios
 
 PAPER_YAML = scenarios._HERE / "paper.yaml"
 PAPER = PAPER_YAML.read_text()
@@ -101,7 +101,7 @@ def test_a_scripted_action_is_checked_as_the_ground_station_would(tmp_path):
 def test_json_scenarios_are_checked_too(tmp_path, suffix):
     import msgspec
 
-    from linecrew.scenarios import load
+    from linecrew_runtime.scenarios import load
 
     path = tmp_path / f"paper{suffix}"
     path.write_bytes(msgspec.json.encode(load("paper")))

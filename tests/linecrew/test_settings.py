@@ -1,4 +1,4 @@
-"""Every process reads its settings one way (linecrew.settings): the same
+"""Every process reads its settings one way (linecrew_runtime.settings): the same
 variable names, conversions, precedence and error message."""
 
 from __future__ import annotations
@@ -10,9 +10,9 @@ import pytest
 
 from ground_station.config import GsConfig
 from ground_station.gateway.settings import GatewaySettings
-from linecrew.bus import BusConfig
-from linecrew.process import DEFAULT_SITE, RunSettings, common_parser, site_id, start
-from linecrew.settings import EnvSettings, variable
+from linecrew_runtime.bus import BusConfig
+from linecrew_runtime.process import DEFAULT_SITE, RunSettings, common_parser, site_id, start
+from linecrew_runtime.settings import EnvSettings, variable
 from onboard_agent.config import AgentConfig
 
 CONFIGS = [AgentConfig, GsConfig, GatewaySettings, BusConfig, RunSettings]
@@ -84,7 +84,7 @@ def started(monkeypatch: pytest.MonkeyPatch, **env: str) -> argparse.Namespace:
     """The flags of a process started without any, under ``env``."""
     for name, value in env.items():
         monkeypatch.setenv(name, value)
-    monkeypatch.setattr("linecrew.process.configure_logging", lambda *_: None)
+    monkeypatch.setattr("linecrew_runtime.process.configure_logging", lambda *_: None)
     args = common_parser("test", "").parse_args([])
     start(args, "test")
     return args

@@ -15,7 +15,7 @@ import sys
 import httpx
 import pytest
 
-from tests.support.processes import Process, free_port, wait_until
+from tests.support.processes import free_port, start, wait_until
 
 
 def survivors(run_dir) -> list[str]:
@@ -59,7 +59,7 @@ def up(tmp_path, monkeypatch):
         "--run-dir",
         str(run_dir),
     ]
-    proc = Process(args, "up")
+    proc = start(args, "up")
     try:
         wait_until(
             lambda: "linecrew is up" in proc.output() or proc.popen.poll() is not None,

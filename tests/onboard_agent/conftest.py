@@ -12,8 +12,8 @@ import time
 import msgspec
 import pytest
 
-from linecrew.bus import Bus
-from linecrew.scenarios import load
+from linecrew_runtime.bus import Bus
+from linecrew_runtime.scenarios import load
 from onboard_agent import Agent, AgentConfig
 from onboard_agent.autopilot.link import MavlinkLink
 from proto.geo import SiteFrame
@@ -23,7 +23,7 @@ from proto.scenario import Scenario
 from proto.site import BatterySwap
 from proto.telemetry import AgentStatus, FlightState, TaskOutcome
 from sim_fleet import Fleet, FleetConfig, FleetThread
-from sim_fleet.vehicle import AutopilotParams
+from sim_fleet.params import AutopilotParams
 from tests.support.processes import running, wait_until
 
 SPEEDUP = 10.0

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 from collections.abc import Callable
 
-from linecrew.scenarios import load
+from linecrew_runtime.scenarios import load
 from onboard_agent import Agent, AgentConfig
 from proto.geo import Point
 from proto.plan import InspectTask, Plan, Task, Waypoint

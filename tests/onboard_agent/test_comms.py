@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import asyncio
 
-from linecrew.bus import Bus
+from linecrew_runtime.bus import Bus
 from onboard_agent.comms import Comms
 from proto.geo import GeoPoint, Point
 from proto.keys import KeySpace, Role

@@ -17,12 +17,12 @@ import msgspec
 import pytest
 from rich.console import Console
 
-from linecrew.bus import Bus, BusConfig
 from linecrew.launch.demo import run_mission
 from linecrew.launch.local_run import LocalRun, RunOptions
 from linecrew.launch.ports import free_udp_block
-from linecrew.process import Shutdown
-from linecrew.scenarios import load
+from linecrew_runtime.bus import Bus, BusConfig
+from linecrew_runtime.process import Shutdown
+from linecrew_runtime.scenarios import load
 from onboard_agent.config import AgentConfig
 from onboard_agent.fleet_host import host
 from proto import KeySpace, MonitorAction, Role, ScriptedAction

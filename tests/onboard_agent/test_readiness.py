@@ -15,7 +15,7 @@ from onboard_agent.autopilot.link import MavlinkLink
 from proto.geo import SiteFrame
 from proto.spots import spot_positions
 from proto.telemetry import AgentState, FlightState
-from sim_fleet.vehicle import AutopilotParams
+from sim_fleet.params import AutopilotParams
 from tests.onboard_agent.conftest import (
     fast_scenario,
     sped_up_agent,

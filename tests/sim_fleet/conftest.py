@@ -6,7 +6,7 @@ from __future__ import annotations
 import pytest
 
 from sim_fleet import Fleet, FleetConfig, FleetThread
-from sim_fleet.vehicle import AutopilotParams
+from sim_fleet.params import AutopilotParams
 from tests.sim_fleet.mavclient import SPEEDUP, Client
 from tests.sim_fleet.small_world import small_world
 

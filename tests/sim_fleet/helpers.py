@@ -15,7 +15,8 @@ from sim_fleet import autopilot as ap
 from sim_fleet.autopilot import Command
 from sim_fleet.events import Outcome
 from sim_fleet.modes import Mode
-from sim_fleet.vehicle import AutopilotParams, Vehicle
+from sim_fleet.params import AutopilotParams
+from sim_fleet.vehicle import Vehicle
 
 QUAD = UavType(
     name="quad",

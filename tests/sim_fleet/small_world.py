@@ -1,5 +1,5 @@
 """A small world for simulator tests, shaped after the paper's (Calvo et al.,
-ICUAS 2022); the paper scenario linecrew ships is ``linecrew.scenarios.load("paper")``.
+ICUAS 2022); the paper scenario linecrew ships is ``linecrew_runtime.scenarios.load("paper")``.
 
 Positions are the paper's; figures it left arbitrary are chosen here to be
 plausible for small multirotors: a 60 Wh pack drawing ~250 W gives ~14 min of

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import pytest
 
-from linecrew.scenarios import load
+from linecrew_runtime.scenarios import load
 from proto import (
     BatteryFault,
     DrainFault,

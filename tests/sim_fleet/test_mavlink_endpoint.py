@@ -8,7 +8,7 @@ import pytest
 
 from sim_fleet import Fleet, FleetConfig, FleetThread
 from sim_fleet.modes import Mode
-from sim_fleet.vehicle import AutopilotParams
+from sim_fleet.params import AutopilotParams
 from tests.sim_fleet.mavclient import SPEEDUP, Client, mavlink
 from tests.sim_fleet.small_world import small_world
 

@@ -18,7 +18,7 @@ import pytest
 
 from sim_fleet import Fleet, FleetConfig, FleetThread
 from sim_fleet.auto_mission import WP_RADIUS_M
-from sim_fleet.vehicle import AutopilotParams
+from sim_fleet.params import AutopilotParams
 from tests.sim_fleet.small_world import small_world
 
 mavsdk = pytest.importorskip("mavsdk")

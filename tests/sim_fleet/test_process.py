@@ -13,8 +13,8 @@ import pytest
 os.environ.setdefault("MAVLINK20", "1")
 from pymavlink import mavutil
 
-from linecrew.bus import Bus
-from linecrew.scenarios import load
+from linecrew_runtime.bus import Bus
+from linecrew_runtime.scenarios import load
 from proto import (
     BatteryFault,
     FaultApplied,

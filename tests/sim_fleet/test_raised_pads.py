@@ -9,7 +9,7 @@ import pytest
 from sim_fleet import Fleet, FleetConfig, FleetThread
 from sim_fleet import autopilot as ap
 from sim_fleet.modes import FlightState
-from sim_fleet.vehicle import AutopilotParams
+from sim_fleet.params import AutopilotParams
 from tests.sim_fleet.helpers import airborne, command, run_until, scenario, station, world
 from tests.sim_fleet.mavclient import Client, mavlink
 

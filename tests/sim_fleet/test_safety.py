@@ -15,9 +15,10 @@ from proto.codec import decode, encode
 from sim_fleet import World
 from sim_fleet import autopilot as ap
 from sim_fleet.modes import FlightState
+from sim_fleet.params import AutopilotParams
 from sim_fleet.safety import SafetyMonitor
 from sim_fleet.truth import sim_state
-from sim_fleet.vehicle import AutopilotParams, Vehicle
+from sim_fleet.vehicle import Vehicle
 from tests.sim_fleet.helpers import QUAD, airborne, command, run_until, scenario, world
 
 

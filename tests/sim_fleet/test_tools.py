@@ -6,7 +6,7 @@ from sim_fleet import World
 from sim_fleet import autopilot as ap
 from sim_fleet.events import Result
 from sim_fleet.modes import FlightState
-from sim_fleet.vehicle import AutopilotParams
+from sim_fleet.params import AutopilotParams
 from tests.sim_fleet.helpers import CARRIER, airborne, command, run_until, world
 from tests.sim_fleet.small_world import small_world
 

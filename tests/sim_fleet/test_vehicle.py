@@ -6,7 +6,7 @@ import pytest
 
 from sim_fleet import autopilot as ap
 from sim_fleet.modes import FlightState, Mode
-from sim_fleet.vehicle import AutopilotParams
+from sim_fleet.params import AutopilotParams
 from tests.sim_fleet.helpers import QUAD, airborne, command, run_until, world
 
 

@@ -9,8 +9,8 @@ import argparse
 import asyncio
 import sys
 
-from linecrew.bus import Bus, BusConfig
-from linecrew.process import Shutdown
+from linecrew_runtime.bus import Bus, BusConfig
+from linecrew_runtime.process import Shutdown
 from proto import EventKind, GetHistory, GsEvent, HistoryReply, KeySpace, RequestError, Role
 
 

@@ -1,26 +1,28 @@
-"""Start real linecrew processes for integration tests and stop them for sure."""
+"""Start real linecrew processes for integration tests, the one way the
+product does (:class:`linecrew.launch.supervisor.Supervisor`), and stop
+them for sure."""
 
 from __future__ import annotations
 
 import contextlib
-import os
-import signal
-import subprocess
+import pathlib
 import sys
 import tempfile
 import time
 from collections.abc import Callable, Iterator
 
-from linecrew.bus import Bus, BusConfig
-from linecrew.bus.router_process import free_port, port_open
+from linecrew.launch.supervisor import Child, Supervisor
+from linecrew_runtime.bus import Bus, BusConfig
+from linecrew_runtime.bus.router_process import free_port, port_open
 
 __all__ = [
-    "Process",
+    "Child",
     "free_port",
     "port_open",
     "router_args",
     "running",
     "running_alive",
+    "start",
     "wait_until",
 ]
 
@@ -40,48 +42,17 @@ def wait_until(
         time.sleep(period_s)
 
 
-class Process:
-    """A child process in its own session, its output captured to a file."""
-
-    def __init__(self, args: list[str], name: str) -> None:
-        self.name = name
-        fd, self.log_path = tempfile.mkstemp(prefix=f"{name}-", suffix=".log")
-        env = dict(os.environ, PYTHONUNBUFFERED="1")
-        with os.fdopen(fd, "wb") as log:
-            self.popen = subprocess.Popen(
-                args, stdout=log, stderr=subprocess.STDOUT, start_new_session=True, env=env
-            )
-
-    def output(self) -> str:
-        """Everything the process printed so far."""
-        with open(self.log_path, errors="replace") as handle:
-            return handle.read()
-
-    def stop(self, timeout_s: float = 10.0) -> int:
-        """SIGTERM, then SIGKILL to the group after ``timeout_s``; the exit code."""
-        if self.popen.poll() is None:
-            with contextlib.suppress(ProcessLookupError):
-                os.killpg(self.popen.pid, signal.SIGTERM)
-            try:
-                self.popen.wait(timeout_s)
-            except subprocess.TimeoutExpired:
-                with contextlib.suppress(ProcessLookupError):
-                    os.killpg(self.popen.pid, signal.SIGKILL)
-                self.popen.wait()
-        return self.popen.returncode
-
-    def kill(self) -> None:
-        """SIGKILL the group now."""
-        with contextlib.suppress(ProcessLookupError):
-            os.killpg(self.popen.pid, signal.SIGKILL)
-        self.popen.wait()
+def start(args: list[str], name: str) -> Child:
+    """Start ``args`` as the product starts its processes (its own session,
+    dying with this one), logging to a fresh directory."""
+    return Supervisor(pathlib.Path(tempfile.mkdtemp(prefix=f"linecrew-{name}-"))).run(name, args)
 
 
 @contextlib.contextmanager
-def running(args: list[str], name: str, ready: Callable[[], object]) -> Iterator[Process]:
+def running(args: list[str], name: str, ready: Callable[[], object]) -> Iterator[Child]:
     """Run a process until the block ends; wait for ``ready()`` first; print
     its log if anything fails."""
-    proc = Process(args, name)
+    proc = start(args, name)
     try:
         wait_until(lambda: ready() or proc.popen.poll() is not None, 20.0, f"{name} ready")
         if proc.popen.poll() is not None:
@@ -98,7 +69,7 @@ def running(args: list[str], name: str, ready: Callable[[], object]) -> Iterator
 @contextlib.contextmanager
 def running_alive(
     args: list[str], name: str, bus_config: BusConfig, token_key: str
-) -> Iterator[Process]:
+) -> Iterator[Child]:
     """:func:`running`, ready once the process's liveliness ``token_key`` is seen."""
     with (
         Bus.open(bus_config) as watcher,
@@ -112,7 +83,7 @@ def router_args(port: int, *extra: str) -> list[str]:
     return [
         sys.executable,
         "-m",
-        "linecrew.bus.router",
+        "linecrew_runtime.bus.router",
         "--listen",
         f"tcp/127.0.0.1:{port}",
         *extra,

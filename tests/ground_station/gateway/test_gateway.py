@@ -13,7 +13,7 @@ import httpx
 import pytest
 
 from ground_station.gateway.main import STREAMS_GRACE_S
-from linecrew.bus import Bus
+from linecrew_runtime.bus import Bus
 from proto import EventKind, GsEvent, KeySpace
 from tests.ground_station.gateway.conftest import TOKEN
 from tests.support.processes import wait_until

@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 from ground_station.gateway.workers import WorkerPoses
-from linecrew.scenarios import load
+from linecrew_runtime.scenarios import load
 from proto.geo import GeoPoint, Point
 from proto.keys import KeySpace
 from proto.telemetry import HumanPose

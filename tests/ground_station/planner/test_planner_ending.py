@@ -145,7 +145,7 @@ def test_the_policy_is_read_and_checked_from_a_document() -> None:
 
 def test_the_scenario_fleet_threads_the_policy_home_by_default() -> None:
     from ground_station.planning import build_problem
-    from linecrew.scenarios import load
+    from linecrew_runtime.scenarios import load
     from proto.fleet import MissionEnd
 
     scenario = load("paper")

@@ -1,5 +1,5 @@
 // The simulation panel: inject the faults of `linecrew fault` (see
-// linecrew/fault_kinds.py and proto/sim.py) through POST /v1/sim/faults.
+// linecrew_runtime/fault_kinds.py and proto/sim.py) through POST /v1/sim/faults.
 // Shown when the gateway offers that endpoint; a gateway without a
 // simulator answers 503, which the panel says.
 

@@ -7,12 +7,12 @@ import signal
 import subprocess
 import sys
 
-from linecrew.process import EXIT_OVERDUE
-from tests.support.processes import Process, wait_until
+from linecrew_runtime.process import EXIT_OVERDUE
+from tests.support.processes import Child, start, wait_until
 
 HANGS_ON_SHUTDOWN = """
 import threading
-from linecrew.process import Shutdown
+from linecrew_runtime.process import Shutdown
 shutdown = Shutdown(deadline_s=1.0).install()
 print("ready", flush=True)
 shutdown.wait()
@@ -21,15 +21,15 @@ threading.Event().wait()  # a close that never returns
 """
 
 STOPS = """
-from linecrew.process import Shutdown
+from linecrew_runtime.process import Shutdown
 shutdown = Shutdown(deadline_s=1.0).install()
 print("ready", flush=True)
 shutdown.wait()
 """
 
 
-def started(code: str) -> Process:
-    proc = Process([sys.executable, "-c", code], "shutdown")
+def started(code: str) -> Child:
+    proc = start([sys.executable, "-c", code], "shutdown")
     wait_until(lambda: "ready" in proc.output(), 30, "the process ready")
     return proc
 

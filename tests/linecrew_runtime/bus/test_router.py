@@ -9,7 +9,7 @@ import subprocess
 
 import pytest
 
-from linecrew.bus import Bus, BusConfig
+from linecrew_runtime.bus import Bus, BusConfig
 from proto import KeySpace, Role
 from tests.support.processes import free_port, port_open, router_args, running, wait_until
 

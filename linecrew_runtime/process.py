@@ -12,9 +12,9 @@ import os
 import signal
 import threading
 
-from linecrew.bus import BusConfig
-from linecrew.logs import configure_logging
-from linecrew.settings import EnvSettings
+from linecrew_runtime.bus import BusConfig
+from linecrew_runtime.logs import configure_logging
+from linecrew_runtime.settings import EnvSettings
 
 log = logging.getLogger(__name__)
 

@@ -19,9 +19,9 @@ from typing import TYPE_CHECKING, Any, TypeVar
 import msgspec
 import zenoh
 
-from linecrew.bus.config import BusConfig
-from linecrew.bus.handoff import AsyncQueue
-from linecrew.bus.stats import BusStats
+from linecrew_runtime.bus.config import BusConfig
+from linecrew_runtime.bus.handoff import AsyncQueue
+from linecrew_runtime.bus.stats import BusStats
 from proto import codec
 from proto.base import MAX_TEXT
 from proto.errors import (

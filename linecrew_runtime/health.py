@@ -5,7 +5,7 @@ Opens a short-lived Zenoh client (same settings as the processes:
 the router for the liveliness token ``alive/{ROLE}/{ID}``. Exit 0 if it is
 there, 1 if not, 2 if no router answers. Made for container healthchecks:
 
-    python -m linecrew.health agent uav-1
+    python -m linecrew_runtime.health agent uav-1
 """
 
 from __future__ import annotations
@@ -13,8 +13,8 @@ from __future__ import annotations
 import argparse
 import sys
 
-from linecrew.bus import Bus, BusConfig
-from linecrew.process import site_id
+from linecrew_runtime.bus import Bus, BusConfig
+from linecrew_runtime.process import site_id
 from proto.errors import LinecrewError, Unavailable
 from proto.keys import KeySpace, Role
 

@@ -25,7 +25,7 @@ def router_process(site: str = "default", lease_ms: int = 1000) -> Iterator[str]
     args = [
         sys.executable,
         "-m",
-        "linecrew.bus.router",
+        "linecrew_runtime.bus.router",
         "--listen",
         endpoint,
         "--site",

@@ -14,7 +14,7 @@ from typing import Literal
 
 import zenoh
 
-from linecrew.settings import EnvSettings
+from linecrew_runtime.settings import EnvSettings
 
 Mode = Literal["client", "peer", "router"]
 DEFAULT_ROUTER = "tcp/127.0.0.1:7447"

@@ -11,7 +11,7 @@ import time
 import pytest
 import zenoh
 
-from linecrew.bus import Bus, BusConfig
+from linecrew_runtime.bus import Bus, BusConfig
 from proto import (
     AgentState,
     AgentStatus,

@@ -2,7 +2,7 @@
 that every other process connects to as a client. Declares the liveliness
 token ``alive/router/{id}`` as its health signal.
 
-Run: ``linecrew router --listen tcp/0.0.0.0:7447`` (or ``python -m linecrew.bus.router``).
+Run: ``linecrew router --listen tcp/0.0.0.0:7447`` (or ``python -m linecrew_runtime.bus.router``).
 """
 
 from __future__ import annotations
@@ -10,8 +10,8 @@ from __future__ import annotations
 import logging
 import sys
 
-from linecrew.bus import DEFAULT_ROUTER, Bus
-from linecrew.process import DEFAULT_SITE, Shutdown, common_parser, start
+from linecrew_runtime.bus import DEFAULT_ROUTER, Bus
+from linecrew_runtime.process import DEFAULT_SITE, Shutdown, common_parser, start
 from proto.errors import Unavailable
 from proto.keys import KeySpace, Role
 

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import pytest
 
-from linecrew.scenarios import ScenarioError, builtin_names, load, parse
+from linecrew_runtime.scenarios import ScenarioError, builtin_names, load, parse
 from proto import DeliverAction, InspectAction, MonitorAction
 
 
@@ -28,7 +28,7 @@ def test_missing_scenario_lists_the_known_ones():
 
 
 def _paper_text() -> str:
-    from linecrew import scenarios
+    from linecrew_runtime import scenarios
 
     return (scenarios._HERE / "paper.yaml").read_text()
 
