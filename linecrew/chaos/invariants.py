@@ -42,6 +42,10 @@ TERMINAL = frozenset({"completed", "failed", "cancelled"})
 HANDOVER_S = 30.0  # mission seconds two monitoring segments of one slot may overlap
 # status task ids that name UAV-scoped work (never shared by construction)
 _OWN_TASKS = ("recharge", "wait", "home")
+EXECUTING_TWICE_S = 3.0
+"""Wall seconds two UAVs' statuses must name one task at once to count as
+doing it twice: longer than a killed agent's last status takes to fall
+silent (a replan may give its task to another meanwhile; chaos seed 12)."""
 CREDIT_TOLERANCE = 0.02  # recorded monitoring may exceed the watched seconds by this share
 CREDIT_SLACK_S = 5.0  # and by this many seconds per UAV of each monitor action
 SAME_SPOT_M = 2.0  # two watching UAVs this near hold one spot (slots, holds, asides: >= 3 m)
@@ -68,7 +72,7 @@ class Checker:
         self.excused: list[str] = []  # below-reserve episodes a fault explains
         self.checks: collections.Counter[str] = collections.Counter()
         self._below: set[str] = set()  # UAVs currently below reserve (one report per episode)
-        self._executing_twice: set[str] = set()  # task ids seen doubled on the last sample
+        self._executing_twice: dict[str, float] = {}  # task id -> seen doubled since
         self._seen: set[tuple[str, str]] = set()  # (invariant, detail) already reported
         self._unsafe_seen = 0  # the simulator's violations already judged
         self._overcredited: set[str] = set()  # workers already reported
@@ -189,15 +193,19 @@ class Checker:
             task_id = status.get("task_id")
             if uav.get("state") in {"lost", "failed"} or not task_id:
                 continue
+            if uav.get("silent_since_s") is not None:
+                continue  # its tasks are unknown: its last status is no evidence
             if status.get("state") != "busy" or task_id.startswith(uav["uav_id"] + "."):
                 continue
             if ".slot" in task_id or any(task_id.endswith(k) for k in _OWN_TASKS):
                 continue  # monitoring hands over; own tasks are never shared
             doers[task_id].append(uav["uav_id"])
         doubled = {t for t, uavs in doers.items() if len(uavs) > 1}
-        for task_id in sorted(doubled & self._executing_twice):
-            self._violate(at_s, "double_task", f"{task_id} executed by {sorted(doers[task_id])}")
-        self._executing_twice = doubled
+        self._executing_twice = {t: self._executing_twice.get(t, at_s) for t in doubled}
+        for task_id, since in sorted(self._executing_twice.items()):
+            if at_s - since >= EXECUTING_TWICE_S:
+                detail = f"{task_id} executed by {sorted(doers[task_id])}"
+                self._violate(at_s, "double_task", detail)
 
     def _check_reserve(self, at_s: float, truth: SimState) -> None:
         self.checks["below_reserve"] += 1

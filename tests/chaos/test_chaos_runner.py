@@ -14,6 +14,7 @@ import httpx
 import pytest
 
 from linecrew.chaos import ChaosOptions, ChaosRunner, Checker, main, make_schedule
+from linecrew.chaos.invariants import EXECUTING_TWICE_S
 from linecrew.chaos.netns import NetnsError
 from linecrew.chaos.report import reproduce
 from linecrew.chaos.schedule import DISRUPTIONS
@@ -60,6 +61,31 @@ def test_the_checker_flags_a_lost_action_and_work_planned_twice():
     assert [v.invariant for v in checker.violations] == ["action_lost", "double_task"]
     checker.finish(2.0, [{"action_id": "a1", "state": "failed", "reason": ""}])
     assert checker.violations[-1].invariant == "failed_without_reason"
+
+
+def test_the_checker_flags_one_task_executed_by_two_only_while_both_are_heard_on_it():
+    """Two UAVs' statuses naming one task count once they have for
+    ``EXECUTING_TWICE_S``; a silent UAV's last status is no evidence (chaos
+    seed 12: a killed agent's last word named the waypoint a replan had
+    just given another, until it fell silent)."""
+
+    def fleet(silent: bool = False) -> list[dict]:
+        busy = {"state": "busy", "task_id": "a2.wp0-0"}
+        quiet = {"silent_since_s": 10.0} if silent else {}
+        return [
+            {"uav_id": "u1", "state": "ok", "status": busy, **quiet},
+            {"uav_id": "u2", "state": "ok", "status": busy},
+        ]
+
+    checker = Checker(reserve_fraction=0.2)
+    checker.sample(10.0, None, None, fleet(), None)
+    checker.sample(11.0, None, None, fleet(), None)
+    checker.sample(12.0, None, None, fleet(silent=True), None)
+    checker.sample(16.0, None, None, fleet(silent=True), None)
+    assert checker.violations == []
+    checker.sample(17.0, None, None, fleet(), None)
+    checker.sample(17.0 + EXECUTING_TWICE_S, None, None, fleet(), None)
+    assert [v.detail for v in checker.violations] == ["a2.wp0-0 executed by ['u1', 'u2']"]
 
 
 def test_the_checker_flags_what_the_simulator_saw_as_unsafe_once_each():
