@@ -48,7 +48,7 @@ Objective = tuple[int, float]
 class Planned:
     """The outcome of one replan on the session."""
 
-    plan: pl.Plan
+    plan: pl.Solution
     base_s: float  # mission seconds of the planner's time 0
     incremental: bool  # events applied to the kept session (else rebuilt)
     events: int  # planner events applied (0 when rebuilt)
@@ -59,7 +59,7 @@ class Planned:
 class Candidate:
     """An improved plan, not yet adopted."""
 
-    plan: pl.Plan
+    plan: pl.Solution
     base_s: float
     before: Objective
     after: Objective

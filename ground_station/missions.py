@@ -30,7 +30,7 @@ from ground_station.lifecycle import TERMINAL, TRANSITIONS, ActionEvent
 from ground_station.monitor_bearings import as_requested, moved_off, with_bearing
 from ground_station.paging import fitting, page
 from ground_station.plan_worker import PlanWorker
-from ground_station.replan_jobs import Computed, Job, ReplanOutcome
+from ground_station.replan_jobs import Computed, ReplanJob, ReplanOutcome
 from ground_station.replanner import Replanner
 from ground_station.store import Store, StoreUnavailable
 from ground_station.validation import validate
@@ -355,11 +355,11 @@ class MissionManager:
             [ActionState.ACCEPTED, ActionState.PLANNED, ActionState.IN_PROGRESS]
         )
 
-    def prepare_replan(self, reason: str) -> Job:
+    def prepare_replan(self, reason: str) -> ReplanJob:
         """A replan's inputs, now (on the loop)."""
         return self.replanner.prepare(self.in_force(), self.clock(), reason)
 
-    def prepare_improvement(self) -> Job:
+    def prepare_improvement(self) -> ReplanJob:
         """An improvement attempt's inputs, now (on the loop)."""
         return self.replanner.prepare_improvement(self.in_force(), self.clock())
 

@@ -13,7 +13,7 @@ IMPOSSIBLE = frozenset({"unreachable_with_full_battery", "unknown_tool"})
 
 
 def placement_events(
-    records: list[ActionRecord], tasks: dict[str, list], result: pl.Plan
+    records: list[ActionRecord], tasks: dict[str, list], result: pl.Solution
 ) -> dict[str, tuple[ActionEvent, str]]:
     """What the adopted plan means for each of ``records`` (its ``tasks`` per
     UAV, planned as ``result``): placed (wholly or partly), unplaced for now,

@@ -25,7 +25,7 @@ import dataclasses
 import logging
 from typing import Protocol
 
-from ground_station.replan_jobs import Computed, Job
+from ground_station.replan_jobs import Computed, ReplanJob
 from ground_station.replanner import Replanner
 from ground_station.store import StoreUnavailable
 from proto.plan import Plan
@@ -52,9 +52,9 @@ class Planned(Protocol):
 
     replanner: Replanner
 
-    def prepare_replan(self, reason: str) -> Job: ...
+    def prepare_replan(self, reason: str) -> ReplanJob: ...
 
-    def prepare_improvement(self) -> Job: ...
+    def prepare_improvement(self) -> ReplanJob: ...
 
     def finish_replan(self, computed: Computed) -> list[Plan] | None: ...
 

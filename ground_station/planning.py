@@ -136,13 +136,13 @@ def build_problem(
             for s in site.stations
         ),
         tool_stations=tuple(
-            pl.ToolStation(
+            pl.ToolDepot(
                 id=t.id, position_m=_xyz(t.position), tools=tuple(tool.name for tool in t.tools)
             )
             for t in site.tool_stations
         ),
         uav_types=tuple(
-            pl.UavType(
+            pl.Airframe(
                 id=t.name,
                 capabilities={str(c): cost for c, cost in t.capabilities.items()},
                 cruise_speed_mps=t.cruise_speed_mps,
@@ -188,7 +188,7 @@ def _action(
     now_s: float,
     monitor_starts: dict[str, float],
     flying_s: float | None,
-) -> pl.Action:
+) -> pl.Job:
     """The planner's action; a delivery's ``worker_m`` is its drop point,
     ``DROP_HEIGHT_M`` above the worker, where the agent releases the tool; a
     monitor's duration is what is left of it (``flying_s``: flown in the
@@ -203,16 +203,16 @@ def _action(
     )
     match action:
         case InspectAction(waypoints=waypoints):
-            return pl.InspectAction(
+            return pl.InspectJob(
                 **common,
                 waypoints=tuple(
-                    pl.Waypoint(position_m=_xyz(w.position), service_s=w.service_s)
+                    pl.Viewpoint(position_m=_xyz(w.position), service_s=w.service_s)
                     for w in waypoints
                 ),
                 done=tuple(record.waypoints_done),
             )
         case MonitorAction():
-            return pl.MonitorAction(
+            return pl.MonitorJob(
                 **common,
                 worker_m=_xyz(workers[action.worker_id]),
                 k=action.uavs,
@@ -225,7 +225,7 @@ def _action(
                 else _promised(monitor_starts.get(record.action_id), now_s),
             )
         case DeliverAction():
-            return pl.DeliverAction(
+            return pl.DeliverJob(
                 **common,
                 tool=action.tool,
                 tool_station=action.tool_station_id,

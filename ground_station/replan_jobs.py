@@ -1,4 +1,4 @@
-"""The vocabulary of a replan: its inputs (:class:`Job`, taken on the loop),
+"""The vocabulary of a replan: its inputs (:class:`ReplanJob`, taken on the loop),
 its result (:class:`Computed`, planned off the loop), what it did
 (:class:`ReplanOutcome`), the counters (:class:`ReplanStats`) and the
 settings of the background improvement (:class:`ImproveSettings`)."""
@@ -44,7 +44,7 @@ class ReplanStats:
 
 
 @dataclasses.dataclass
-class Job:
+class ReplanJob:
     """A replan's inputs, taken on the loop; planned on the worker's thread."""
 
     records: list[ActionRecord]
@@ -61,9 +61,9 @@ class Job:
 class Computed:
     """A replan's result, to be committed on the loop."""
 
-    job: Job
+    job: ReplanJob
     tasks: dict[str, list[Task]]
-    result: pl.Plan | None = None  # None: the planner refused the problem
+    result: pl.Solution | None = None  # None: the planner refused the problem
     error: str = ""
     elapsed_s: float = 0.0
     incremental: bool = False

@@ -36,7 +36,13 @@ from ground_station.planning import (
     name_reliefs,
     same_work,
 )
-from ground_station.replan_jobs import Computed, ImproveSettings, Job, ReplanOutcome, ReplanStats
+from ground_station.replan_jobs import (
+    Computed,
+    ImproveSettings,
+    ReplanJob,
+    ReplanOutcome,
+    ReplanStats,
+)
 from ground_station.store import Store, StoreUnavailable
 from ground_station.wire_tasks import to_tasks
 from proto.events import EventKind
@@ -146,10 +152,10 @@ class Replanner:
         assert outcome is not None  # nothing can change in between
         return outcome
 
-    def prepare(self, records: list[ActionRecord], now_s: float, reason: str) -> Job:
+    def prepare(self, records: list[ActionRecord], now_s: float, reason: str) -> ReplanJob:
         """The inputs of a replan, as the mission stands (on the loop)."""
         in_force = {r.action_id for r in records}
-        return Job(
+        return ReplanJob(
             records=list(records),
             now_s=now_s,
             reason=reason,
@@ -166,7 +172,7 @@ class Replanner:
             flying=flying_segments(self.monitor, self.plans, in_force),
         )
 
-    def compute(self, job: Job) -> Computed:
+    def compute(self, job: ReplanJob) -> Computed:
         """Plan ``job`` on the live session (pure: any thread, one at a time)."""
         site, fleet = self.scenario.site, self.scenario.fleet
         capacities = {u.id: capacity_wh(fleet, u.id) for u in fleet.uavs}
@@ -200,7 +206,7 @@ class Replanner:
             incremental=planned.incremental,
         )
 
-    def _wire(self, result: pl.Plan, job: Job, base_s: float) -> dict:
+    def _wire(self, result: pl.Solution, job: ReplanJob, base_s: float) -> dict:
         site, fleet = self.scenario.site, self.scenario.fleet
         by_id = {r.action_id: r for r in job.records}
         return name_reliefs(
@@ -301,7 +307,7 @@ class Replanner:
             and not self.live.stale
         )
 
-    def prepare_improvement(self, records: list[ActionRecord], now_s: float) -> Job:
+    def prepare_improvement(self, records: list[ActionRecord], now_s: float) -> ReplanJob:
         """An improvement attempt's inputs (on the loop): the tasks frozen now."""
         job = self.prepare(records, now_s, "improvement")
         job.frozen = self._frozen(now_s)
@@ -324,7 +330,9 @@ class Replanner:
         telemetry = self.monitor.telemetry(uav_id)
         return telemetry is not None and telemetry.flight_state in AIRBORNE
 
-    def improve(self, job: Job, should_stop: Callable[[], bool] = lambda: False) -> Computed | None:
+    def improve(
+        self, job: ReplanJob, should_stop: Callable[[], bool] = lambda: False
+    ) -> Computed | None:
         """Try to improve the live plan (pure: on the worker's thread). The
         result is committed only through ``adopt``."""
         s = self.improve_settings

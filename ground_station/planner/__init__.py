@@ -1,7 +1,7 @@
 """ground_station.planner: the mission planner, a pure deterministic library.
 
 ``plan(problem)`` turns a ``Problem`` (fleet, stations, actions) into a
-``Plan`` (per-UAV timed steps, unplaced parts with reasons, metrics);
+``Solution`` (per-UAV timed steps, unplaced parts with reasons, metrics);
 ``validate(problem, plan)`` checks any plan independently. No I/O, no clock.
 """
 
@@ -15,18 +15,18 @@ from ground_station.planner.load import (
 )
 from ground_station.planner.metrics import compute_metrics
 from ground_station.planner.model import (
-    Action,
+    Airframe,
     CostWeights,
-    DeliverAction,
-    InspectAction,
-    MonitorAction,
+    DeliverJob,
+    InspectJob,
+    Job,
+    MonitorJob,
     Problem,
     RunningTask,
     Station,
-    ToolStation,
+    ToolDepot,
     Uav,
-    UavType,
-    Waypoint,
+    Viewpoint,
 )
 from ground_station.planner.replan import (
     ActionAdded,
@@ -40,40 +40,40 @@ from ground_station.planner.replan import (
     UavLost,
     replan_once,
 )
-from ground_station.planner.result import Metrics, Plan, Step, UavPlan, Unplaced, Violation
+from ground_station.planner.result import Metrics, Solution, Step, UavPlan, Unplaced, Violation
 from ground_station.planner.routes import Options
 from ground_station.planner.validate import validate
 
 __all__ = [
-    "Action",
     "ActionAdded",
     "ActionCancelled",
     "ActionChanged",
+    "Airframe",
     "BatteryLow",
     "CostWeights",
-    "DeliverAction",
+    "DeliverJob",
     "Event",
-    "InspectAction",
+    "InspectJob",
+    "Job",
     "Metrics",
-    "MonitorAction",
+    "MonitorJob",
     "Options",
-    "Plan",
     "PlanningProblemError",
     "Problem",
     "RunningTask",
     "Session",
+    "Solution",
     "Station",
     "Step",
     "TaskFinished",
-    "ToolStation",
+    "ToolDepot",
     "Uav",
     "UavBack",
     "UavLost",
     "UavPlan",
-    "UavType",
     "Unplaced",
+    "Viewpoint",
     "Violation",
-    "Waypoint",
     "check_problem",
     "compute_metrics",
     "plan",

@@ -14,7 +14,7 @@ from ground_station.planner.heuristic import build
 from ground_station.planner.improve import Score, improve
 from ground_station.planner.load import check_problem
 from ground_station.planner.model import CostWeights, Problem
-from ground_station.planner.result import Plan
+from ground_station.planner.result import Solution
 from ground_station.planner.routes import Ctx, Options
 
 
@@ -53,7 +53,7 @@ RESTART_WORK = 3000
 small instances, none from about 20 UAVs x 150 actions up)."""
 
 
-def score(p: Plan) -> Score:
+def score(p: Solution) -> Score:
     """What improvement minimises: (unplaced parts, weight-averaged completion
     time + makespan), both in seconds from ``now_s`` and of similar size, so
     neither the priority-weighted service nor the end of the mission is
@@ -87,7 +87,7 @@ def plan(
     should_stop: Callable[[], bool] | None = None,
     max_rounds: int = 0,
     seed: int = 0,
-) -> Plan:
+) -> Solution:
     """Plan ``problem``: the complete heuristic (or ``options.mode``), then,
     if ``should_stop`` or ``max_rounds`` is given, improvement.
 
@@ -100,7 +100,7 @@ def plan(
     ``should_stop`` is polled between constructions and rounds: pass e.g. a
     deadline check built on the caller's clock. Pure and deterministic for a
     given sequence of ``should_stop`` answers. Raises ``PlanningProblemError``
-    for invalid input; what cannot be placed is listed in ``Plan.unplaced``.
+    for invalid input; what cannot be placed is listed in ``Solution.unplaced``.
     """
     if not isinstance(problem, Problem):
         raise PlanningProblemError("$", "expected a Problem")
@@ -138,7 +138,7 @@ class _Start(NamedTuple):
 
 def _starts(
     problem: Problem, options: Options, ctx: Ctx, stop: Callable[[], bool], max_rounds: int
-) -> tuple[list[_Start], Plan]:
+) -> tuple[list[_Start], Solution]:
     """The constructions to improve, best first (``ctx``, the complete
     heuristic's, wins ties), and the best plan among them; unless ``options``
     is paper mode, the paper heuristic's too and, time-bounded, the

@@ -18,7 +18,7 @@ from math import dist
 
 import msgspec
 
-from ground_station.planner.energy import EPS_S, EPS_WH, Kin, Site
+from ground_station.planner.energy import EPS_S, EPS_WH, Kin, SiteMap
 from ground_station.planner.model import Vec3
 from ground_station.planner.pads import Ignore, Pads
 from ground_station.planner.recharge import RcOption, emit_recharge
@@ -64,7 +64,7 @@ def landing_step(k: Kin, st: State, pos: Vec3, station_id: str, d: float) -> Ste
 
 
 def end_steps(
-    k: Kin, site: Site, pads: Pads, st: State, ign: Ignore
+    k: Kin, site: SiteMap, pads: Pads, st: State, ign: Ignore
 ) -> tuple[list[Step], list[Booking]]:
     """Steps that end the mission from ``st`` and their reservations."""
     steps: list[Step] = []
@@ -99,7 +99,7 @@ class _Way:
     """A* (Dijkstra for ``any_station``) over the charging stations and, as
     node ``n``, the home station if it is a landing spot only."""
 
-    def __init__(self, k: Kin, site: Site, pads: Pads, ign: Ignore, home: int) -> None:
+    def __init__(self, k: Kin, site: SiteMap, pads: Pads, ign: Ignore, home: int) -> None:
         self.k, self.site, self.pads, self.ign, self.home = k, site, pads, ign, home
         self.n = n = len(site.positions)
         self.anywhere = site.end == "any_station"
@@ -162,7 +162,7 @@ class _Way:
             self._push(j, Label(arrive, rc.e_at_task, i, rc))
 
 
-def _nearest_landing(k: Kin, site: Site, st: State) -> list[Step]:
+def _nearest_landing(k: Kin, site: SiteMap, st: State) -> list[Step]:
     """No way to an end: land at the nearest station (landing spots are not pads)."""
     near = site.nearest(st.pos)
     si = near.station

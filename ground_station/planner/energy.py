@@ -13,7 +13,7 @@ from operator import add
 import msgspec
 
 from ground_station.planner.holds import HoldPoints
-from ground_station.planner.model import Problem, Station, Uav, UavType, Vec3
+from ground_station.planner.model import Airframe, Problem, Station, Uav, Vec3
 
 EPS_S = 1e-6
 EPS_WH = 1e-6
@@ -34,7 +34,7 @@ class Kin:
         "wh_per_m",
     )
 
-    def __init__(self, uav: Uav, utype: UavType, reserve_fraction: float, home: Station) -> None:
+    def __init__(self, uav: Uav, utype: Airframe, reserve_fraction: float, home: Station) -> None:
         self.uav_id = uav.id
         self.speed_mps = utype.cruise_speed_mps
         self.wh_per_m = utype.flight_power_w / utype.cruise_speed_mps / 3600.0
@@ -70,7 +70,7 @@ class Nearest(msgspec.Struct, frozen=True, gc=False):
     station: int
 
 
-class Site:
+class SiteMap:
     """Charging stations (``index`` by id) with memoised distance and
     nearest-station lookups, the end-of-mission policy, and the index of
     each hold point's one-at-a-time reservation timeline in the shared

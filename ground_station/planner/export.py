@@ -1,4 +1,4 @@
-"""Turning the planning state into a ``Plan`` document."""
+"""Turning the planning state into a ``Solution``."""
 
 from __future__ import annotations
 
@@ -6,7 +6,7 @@ from math import dist
 
 from ground_station.planner.ending import end_steps, landing_step
 from ground_station.planner.metrics import compute_metrics
-from ground_station.planner.result import Plan, Step, UavPlan, Unplaced
+from ground_station.planner.result import Solution, Step, UavPlan, Unplaced
 from ground_station.planner.routes import Ctx
 
 
@@ -20,7 +20,7 @@ def emergency_steps(ctx: Ctx, uid: str) -> tuple[Step, ...]:
     return (landing_step(grounded.kin, st, station.position_m, station.id, d),)
 
 
-def export(ctx: Ctx) -> Plan:
+def export(ctx: Ctx) -> Solution:
     """The plan: every UAV's steps (home legs added), unplaced parts, metrics."""
     pads = ctx.pads.copy()
     uavs = []
@@ -38,5 +38,7 @@ def export(ctx: Ctx) -> Plan:
     unplaced: list[Unplaced] = []
     for a in ctx.problem.actions:
         unplaced.extend(ctx.unplaced.get(a.id, ()))
-    plan = Plan(uavs=tuple(uavs), unplaced=tuple(unplaced))
-    return Plan(uavs=plan.uavs, unplaced=plan.unplaced, metrics=compute_metrics(ctx.problem, plan))
+    plan = Solution(uavs=tuple(uavs), unplaced=tuple(unplaced))
+    return Solution(
+        uavs=plan.uavs, unplaced=plan.unplaced, metrics=compute_metrics(ctx.problem, plan)
+    )

@@ -14,15 +14,15 @@ import msgspec
 
 from ground_station.planner import insertion, monitor
 from ground_station.planner.model import (
-    Action,
-    DeliverAction,
-    InspectAction,
-    MonitorAction,
+    DeliverJob,
+    InspectJob,
+    Job,
+    MonitorJob,
     Problem,
     Vec3,
 )
 from ground_station.planner.routes import Ctx, Options, Snapshot, new_ctx, queue_order
-from ground_station.planner.simulate import State, Task
+from ground_station.planner.simulate import State, Visit
 from ground_station.planner.split import chunk_all, equal_chunks, fixed_split_count
 
 SPLITS_TRIED = 1
@@ -44,7 +44,7 @@ def reachable(ctx: Ctx, kind: str, pos: Vec3, service_s: float) -> bool:
     return False
 
 
-def place_deliver(ctx: Ctx, a: DeliverAction) -> None:
+def place_deliver(ctx: Ctx, a: DeliverJob) -> None:
     if (a.id, None) in ctx.pinned:
         return
     if not ctx.capable("deliver"):
@@ -61,11 +61,11 @@ def place_deliver(ctx: Ctx, a: DeliverAction) -> None:
         ctx.add_unplaced(a.id, None, "unreachable_with_full_battery")
         return
 
-    def make(st: State) -> list[Task]:
-        drop = Task("deliver", a.id, None, a.worker_m, a.drop_s, a.release_s, tool=a.tool)
+    def make(st: State) -> list[Visit]:
+        drop = Visit("deliver", a.id, None, a.worker_m, a.drop_s, a.release_s, tool=a.tool)
         if st.tool == a.tool:
             return [drop]
-        pick = Task("pick", a.id, None, ts.position_m, a.pick_s, a.release_s, tool=a.tool)
+        pick = Visit("pick", a.id, None, ts.position_m, a.pick_s, a.release_s, tool=a.tool)
         return [pick, drop]
 
     choice, reason = insertion.best_insertion(
@@ -85,7 +85,7 @@ def place_deliver(ctx: Ctx, a: DeliverAction) -> None:
         insertion.apply(ctx, choice)
 
 
-def _place_chunk(ctx: Ctx, a: InspectAction, idx: list[int]) -> tuple[float, float]:
+def _place_chunk(ctx: Ctx, a: InspectJob, idx: list[int]) -> tuple[float, float]:
     """Place one contiguous chunk; returns (finish, added UAV time).
 
     A chunk no UAV can take whole is placed waypoint by waypoint; waypoints
@@ -93,7 +93,7 @@ def _place_chunk(ctx: Ctx, a: InspectAction, idx: list[int]) -> tuple[float, flo
     """
     wps = a.waypoints
     tasks = [
-        Task("inspect", a.id, i, wps[i].position_m, wps[i].service_s, a.release_s) for i in idx
+        Visit("inspect", a.id, i, wps[i].position_m, wps[i].service_s, a.release_s) for i in idx
     ]
     work = sum(t.service_s for t in tasks)
     path = sum(dist(tasks[i - 1].pos, tasks[i].pos) for i in range(1, len(tasks)))
@@ -122,7 +122,7 @@ def _place_chunk(ctx: Ctx, a: InspectAction, idx: list[int]) -> tuple[float, flo
     return finish, used
 
 
-def place_inspect(ctx: Ctx, a: InspectAction, only: list[int] | None = None) -> None:
+def place_inspect(ctx: Ctx, a: InspectJob, only: list[int] | None = None) -> None:
     """Place an inspection's waypoints (``only`` those, if given) in
     contiguous chunks; the split count is the best estimate's (paper mode:
     the paper's fixed count)."""
@@ -150,7 +150,7 @@ def place_inspect(ctx: Ctx, a: InspectAction, only: list[int] | None = None) -> 
         _place_best_split(ctx, a, ok, [splits[m] for m in tried])
 
 
-def _placeable(ctx: Ctx, a: InspectAction, only: list[int] | None) -> list[int]:
+def _placeable(ctx: Ctx, a: InspectJob, only: list[int] | None) -> list[int]:
     """The waypoints to place (not done, not running); the others that no
     UAV can take are reported unplaced."""
     skip = set(a.done) | {i for aid, i in ctx.pinned if aid == a.id}
@@ -170,7 +170,7 @@ def _placeable(ctx: Ctx, a: InspectAction, only: list[int] | None) -> list[int]:
 
 
 def _place_split(
-    ctx: Ctx, a: InspectAction, ok: list[int], chunks: list[list[int]]
+    ctx: Ctx, a: InspectJob, ok: list[int], chunks: list[list[int]]
 ) -> tuple[float, float]:
     """Place each chunk (indices into ``ok``); (finish, added UAV time)."""
     finish, used = ctx.problem.now_s, 0.0
@@ -181,7 +181,7 @@ def _place_split(
 
 
 def _place_best_split(
-    ctx: Ctx, a: InspectAction, ok: list[int], splits: list[list[list[int]]]
+    ctx: Ctx, a: InspectJob, ok: list[int], splits: list[list[list[int]]]
 ) -> None:
     """Place the best of ``splits``: fewest unplaced waypoints, then finish
     plus ``resource_factor`` x the UAV time used."""
@@ -210,7 +210,7 @@ class _Tail(msgspec.Struct, frozen=True, gc=False):
 
 
 def _estimate(
-    ctx: Ctx, a: InspectAction, ok: list[int], chunks: list[list[int]], fleet: list[_Tail]
+    ctx: Ctx, a: InspectJob, ok: list[int], chunks: list[list[int]], fleet: list[_Tail]
 ) -> float:
     """Cheap score of a split: each chunk on the UAV that could finish it
     first (tails only, no battery), as ``place_inspect`` scores real splits."""
@@ -255,11 +255,11 @@ def _fleet(ctx: Ctx, uids: list[str]) -> list[_Tail]:
     return out
 
 
-def place_action(ctx: Ctx, a: Action, only: list[int] | None = None) -> None:
+def place_action(ctx: Ctx, a: Job, only: list[int] | None = None) -> None:
     """Place one action (or only some waypoints of an inspection)."""
-    if isinstance(a, InspectAction):
+    if isinstance(a, InspectJob):
         place_inspect(ctx, a, only)
-    elif isinstance(a, MonitorAction):
+    elif isinstance(a, MonitorJob):
         monitor.place_monitor(ctx, a)
     else:
         place_deliver(ctx, a)

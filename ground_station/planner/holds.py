@@ -16,10 +16,10 @@ from math import dist
 
 from ground_station.planner.model import (
     WAIT_ASIDE_M,
-    Action,
-    DeliverAction,
-    InspectAction,
-    MonitorAction,
+    DeliverJob,
+    InspectJob,
+    Job,
+    MonitorJob,
     Problem,
     Vec3,
     slot_position,
@@ -57,15 +57,15 @@ class HoldPoints:
             g = self._parent[g]
         return g
 
-    def add_action(self, action: Action) -> list[tuple[int, int]]:
+    def add_action(self, action: Job) -> list[tuple[int, int]]:
         """Register the points ``action`` holds UAVs at; the groups this
         merged, as ``(merged, joined)`` pairs."""
-        if isinstance(action, DeliverAction):
+        if isinstance(action, DeliverJob):
             return self._add(action.worker_m)
-        if isinstance(action, InspectAction):
+        if isinstance(action, InspectJob):
             return [m for w in action.waypoints for m in self._add(w.position_m)]
         merged = []
-        if isinstance(action, MonitorAction):
+        if isinstance(action, MonitorJob):
             for slot in range(action.k):
                 aside = slot_position(action, slot, WAIT_ASIDE_M)
                 self._aside[slot_position(action, slot)] = aside

@@ -28,7 +28,7 @@ from ground_station.planner.ending import end_steps
 from ground_station.planner.model import CostWeights
 from ground_station.planner.removal import remove
 from ground_station.planner.routes import Ctx, Snapshot, queue_order
-from ground_station.planner.simulate import Task
+from ground_station.planner.simulate import Visit
 
 THRESHOLD = 0.002
 """Accept a round up to this fraction worse than the current state."""
@@ -110,7 +110,7 @@ def _late(ctx: Ctx) -> list[str]:
 def _remove(ctx: Ctx, aid: str) -> bool:
     for uid in ctx.placed_uavs(aid):
 
-        def mine(t: Task) -> bool:
+        def mine(t: Visit) -> bool:
             return t.action_id == aid and (aid, t.index) not in ctx.pinned
 
         if not remove(ctx, uid, mine):

@@ -17,7 +17,7 @@ import msgspec
 from ground_station.planner import costs
 from ground_station.planner.model import Vec3
 from ground_station.planner.routes import Ctx, GapCache
-from ground_station.planner.simulate import Sim, State, Task
+from ground_station.planner.simulate import Sim, State, Visit
 
 MIN_GAP_S = 5.0
 MAX_GAP_EVAL = 2
@@ -34,7 +34,7 @@ class Choice(NamedTuple):
     cost: float
     uid: str
     pos: int
-    tasks: list[Task]
+    tasks: list[Visit]
     sim: Sim
     finish_s: float
     delay_s: float
@@ -144,7 +144,7 @@ def best_insertion(
     start: Vec3,
     work_s: float,
     release_s: float,
-    make: Callable[[State], list[Task]],
+    make: Callable[[State], list[Visit]],
     uids: list[str] | None = None,
     end: Vec3 | None = None,
     path_m: float = 0.0,
@@ -177,7 +177,7 @@ def _cheapest(
     terms: dict[str, _Terms],
     action_id: str,
     start: Vec3,
-    make: Callable[[State], list[Task]],
+    make: Callable[[State], list[Visit]],
 ) -> Choice | None:
     """Simulate candidates in order of their bounds until no later one can
     win or the evaluation budget (``Options.max_eval`` route ends, a few
@@ -216,7 +216,7 @@ def _simulated(
     terms: _Terms,
     action_id: str,
     start: Vec3,
-    make: Callable[[State], list[Task]],
+    make: Callable[[State], list[Visit]],
 ) -> Choice | None:
     """The insertion at ``pos`` (-1: before the running task) simulated and
     costed (paper mode: its bound ``lb``); None if it does not fit."""

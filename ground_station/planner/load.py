@@ -9,13 +9,13 @@ import msgspec
 from ground_station.planner.errors import PlanningProblemError
 from ground_station.planner.model import (
     KINDS,
-    Action,
-    DeliverAction,
-    InspectAction,
-    MonitorAction,
+    DeliverJob,
+    InspectJob,
+    Job,
+    MonitorJob,
     Problem,
 )
-from ground_station.planner.result import Plan
+from ground_station.planner.result import Solution
 
 
 def _field_of(err: msgspec.ValidationError) -> tuple[str, str]:
@@ -48,10 +48,10 @@ def problem_from_json(text: str | bytes) -> Problem:
     return problem_from_obj(obj)
 
 
-def plan_from_json(text: str | bytes) -> Plan:
+def plan_from_json(text: str | bytes) -> Solution:
     """Decode a JSON plan document; raises ``PlanningProblemError``."""
     try:
-        return msgspec.json.decode(text, type=Plan)
+        return msgspec.json.decode(text, type=Solution)
     except msgspec.ValidationError as err:
         raise PlanningProblemError(*_field_of(err)) from None
     except msgspec.DecodeError as err:
@@ -133,11 +133,11 @@ def _check_uavs(p: Problem) -> None:
             _positive(f"{base}.running.remaining_s", u.running.remaining_s, zero_ok=True)
 
 
-def _check_action(base: str, a: Action, tool_stations: set[str]) -> None:
+def _check_action(base: str, a: Job, tool_stations: set[str]) -> None:
     """One action's fields (``base`` is its path)."""
     _positive(f"{base}.weight", a.weight)
     _positive(f"{base}.release_s", a.release_s, zero_ok=True)
-    if isinstance(a, InspectAction):
+    if isinstance(a, InspectJob):
         if not a.waypoints:
             raise PlanningProblemError(f"{base}.waypoints", "must not be empty")
         for j, w in enumerate(a.waypoints):
@@ -145,12 +145,12 @@ def _check_action(base: str, a: Action, tool_stations: set[str]) -> None:
         for j, d in enumerate(a.done):
             if not 0 <= d < len(a.waypoints):
                 raise PlanningProblemError(f"{base}.done[{j}]", "waypoint index out of range")
-    elif isinstance(a, MonitorAction):
+    elif isinstance(a, MonitorJob):
         _positive(f"{base}.duration_s", a.duration_s)
         _positive(f"{base}.standoff_m", a.standoff_m, zero_ok=True)
         if a.k < 1:
             raise PlanningProblemError(f"{base}.k", "must be >= 1")
-    elif isinstance(a, DeliverAction):
+    elif isinstance(a, DeliverJob):
         _positive(f"{base}.pick_s", a.pick_s, zero_ok=True)
         _positive(f"{base}.drop_s", a.drop_s, zero_ok=True)
         if a.tool_station not in tool_stations:
@@ -170,7 +170,7 @@ def _check_running(p: Problem) -> None:
             raise PlanningProblemError(f"$.uavs[{i}].running.action_id", "unknown action")
         if act.release_s > p.now_s:
             raise PlanningProblemError(f"$.uavs[{i}].running.action_id", "action not released yet")
-        if isinstance(act, InspectAction) and not 0 <= u.running.index < len(act.waypoints):
+        if isinstance(act, InspectJob) and not 0 <= u.running.index < len(act.waypoints):
             raise PlanningProblemError(f"$.uavs[{i}].running.index", "waypoint out of range")
-        if isinstance(act, DeliverAction) and u.tool != act.tool:
+        if isinstance(act, DeliverJob) and u.tool != act.tool:
             raise PlanningProblemError(f"$.uavs[{i}].tool", "running delivery without its tool")

@@ -3,10 +3,10 @@
 from __future__ import annotations
 
 from ground_station.planner.model import Problem
-from ground_station.planner.result import Metrics, Plan
+from ground_station.planner.result import Metrics, Solution
 
 
-def completion_times(plan: Plan) -> dict[str, float]:
+def completion_times(plan: Solution) -> dict[str, float]:
     """Per action, the end of its last step (deliver, last waypoint, monitoring end)."""
     out: dict[str, float] = {}
     for up in plan.uavs:
@@ -20,7 +20,7 @@ def completion_times(plan: Plan) -> dict[str, float]:
     return out
 
 
-def compute_metrics(problem: Problem, plan: Plan, planning_time_s: float = 0.0) -> Metrics:
+def compute_metrics(problem: Problem, plan: Solution, planning_time_s: float = 0.0) -> Metrics:
     """Makespan, distance, energy used, recharges, weighted completion."""
     now = problem.now_s
     types = {t.id: t for t in problem.uav_types}

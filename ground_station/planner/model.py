@@ -41,7 +41,7 @@ class Station(msgspec.Struct, frozen=True, kw_only=True):
     full_charge_s: float = 1800.0
 
 
-class ToolStation(msgspec.Struct, frozen=True, kw_only=True):
+class ToolDepot(msgspec.Struct, frozen=True, kw_only=True):
     """A pick-up point holding (any number of copies of) ``tools``."""
 
     id: str
@@ -49,7 +49,7 @@ class ToolStation(msgspec.Struct, frozen=True, kw_only=True):
     tools: tuple[str, ...] = ()
 
 
-class UavType(msgspec.Struct, frozen=True, kw_only=True):
+class Airframe(msgspec.Struct, frozen=True, kw_only=True):
     """A UAV model.
 
     ``capabilities`` maps an action kind to its suitability cost J1 in 0..1
@@ -93,24 +93,24 @@ class Uav(msgspec.Struct, frozen=True, kw_only=True):
     running: RunningTask | None = None
 
 
-class Waypoint(msgspec.Struct, frozen=True, kw_only=True):
+class Viewpoint(msgspec.Struct, frozen=True, kw_only=True):
     """An inspection point and the time spent servicing it (hovering)."""
 
     position_m: Vec3
     service_s: float = 0.0
 
 
-class InspectAction(msgspec.Struct, frozen=True, kw_only=True, tag="inspect", tag_field="kind"):
+class InspectJob(msgspec.Struct, frozen=True, kw_only=True, tag="inspect", tag_field="kind"):
     """Inspect ordered ``waypoints``; indices in ``done`` are already inspected."""
 
     id: str
     weight: float = 1.0
     release_s: float = 0.0
-    waypoints: tuple[Waypoint, ...]
+    waypoints: tuple[Viewpoint, ...]
     done: tuple[int, ...] = ()
 
 
-class MonitorAction(msgspec.Struct, frozen=True, kw_only=True, tag="monitor", tag_field="kind"):
+class MonitorJob(msgspec.Struct, frozen=True, kw_only=True, tag="monitor", tag_field="kind"):
     """Watch a worker with ``k`` UAVs starting together, for ``duration_s``.
 
     Slot ``s`` sits ``standoff_m`` from the worker horizontally at bearing
@@ -138,7 +138,7 @@ WAIT_ASIDE_M = 3.0
 along the ring (counter-clockwise) from its slot, clear of its relief."""
 
 
-def slot_position(a: MonitorAction, slot: int, aside_m: float = 0.0) -> Vec3:
+def slot_position(a: MonitorJob, slot: int, aside_m: float = 0.0) -> Vec3:
     """Stand-off position of ``slot`` (bearing ``bearing_deg`` + 360*slot/k
     degrees, ``height_m`` above the worker), ``aside_m`` along the ring."""
     x, y, z = a.worker_m
@@ -151,7 +151,7 @@ def slot_position(a: MonitorAction, slot: int, aside_m: float = 0.0) -> Vec3:
     )
 
 
-class DeliverAction(msgspec.Struct, frozen=True, kw_only=True, tag="deliver", tag_field="kind"):
+class DeliverJob(msgspec.Struct, frozen=True, kw_only=True, tag="deliver", tag_field="kind"):
     """Pick ``tool`` at ``tool_station`` and bring it to the worker."""
 
     id: str
@@ -164,7 +164,7 @@ class DeliverAction(msgspec.Struct, frozen=True, kw_only=True, tag="deliver", ta
     drop_s: float = 10.0
 
 
-Action = InspectAction | MonitorAction | DeliverAction
+Job = InspectJob | MonitorJob | DeliverJob
 
 
 class CostWeights(msgspec.Struct, frozen=True, kw_only=True):
@@ -197,10 +197,10 @@ class Problem(msgspec.Struct, frozen=True, kw_only=True):
     now_s: float = 0.0
     reserve_fraction: float = 0.2
     stations: tuple[Station, ...]
-    tool_stations: tuple[ToolStation, ...] = ()
-    uav_types: tuple[UavType, ...]
+    tool_stations: tuple[ToolDepot, ...] = ()
+    uav_types: tuple[Airframe, ...]
     uavs: tuple[Uav, ...]
-    actions: tuple[Action, ...] = ()
+    actions: tuple[Job, ...] = ()
     weights: CostWeights = CostWeights()
     min_monitor_segment_s: float = 20.0
     min_altitude_m: float = 0.0

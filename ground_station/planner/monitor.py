@@ -25,11 +25,11 @@ import msgspec
 
 from ground_station.planner import costs
 from ground_station.planner.energy import EPS_S
-from ground_station.planner.model import MonitorAction, Vec3, slot_position
+from ground_station.planner.model import MonitorJob, Vec3, slot_position
 from ground_station.planner.monitor_start import ReadyTimes, start_times
 from ground_station.planner.reach import monitor_reach
 from ground_station.planner.routes import Ctx, Snapshot
-from ground_station.planner.simulate import Task
+from ground_station.planner.simulate import Visit
 
 MAX_REACH = 3
 """UAVs (best first by suitability and distance) examined for each segment."""
@@ -45,7 +45,7 @@ early for other work."""
 SHUFFLE_P = 0.2
 """Improvement only: the chance that segment candidates are tried in random order."""
 EARLIER_S = 30.0
-"""A promised start (``MonitorAction.start_s``) stands unless the action
+"""A promised start (``MonitorJob.start_s``) stands unless the action
 can start at least this much earlier now (a UAV came back or was freed):
 small gains never move a start the UAVs are already flying to."""
 
@@ -58,7 +58,7 @@ class Need(msgspec.Struct, frozen=True, order=True, gc=False):
     end_s: float
 
 
-def segment_needs(tasks: Iterable[Task]) -> list[Need]:
+def segment_needs(tasks: Iterable[Visit]) -> list[Need]:
     """What the monitoring segments among ``tasks`` cover."""
     return [
         Need(t.anchor_s, t.index, t.anchor_s + t.service_s)
@@ -102,7 +102,7 @@ class _Coverage(NamedTuple):
 
 
 def _cover(
-    ctx: Ctx, a: MonitorAction, t0: float, uids: list[str], ready: dict[str, float] | None = None
+    ctx: Ctx, a: MonitorJob, t0: float, uids: list[str], ready: dict[str, float] | None = None
 ) -> float | None:
     """Tentatively commit a full coverage from ``t0``; its cost, or None."""
     end = t0 + a.duration_s
@@ -146,7 +146,7 @@ def _rank_uavs(ctx: Ctx, fleet: list[_Member], pos: Vec3, t: float, push: bool) 
     return out
 
 
-def _members(ctx: Ctx, a: MonitorAction, uids: list[str]) -> list[_Member]:
+def _members(ctx: Ctx, a: MonitorJob, uids: list[str]) -> list[_Member]:
     """The UAVs ``uids`` with their fixed costs for ``a``."""
     w = ctx.weights
     out = []
@@ -159,7 +159,7 @@ def _members(ctx: Ctx, a: MonitorAction, uids: list[str]) -> list[_Member]:
 
 def _cover_needs(
     ctx: Ctx,
-    a: MonitorAction,
+    a: MonitorJob,
     needs: list[Need],
     uids: list[str],
     push: bool = False,
@@ -203,7 +203,7 @@ def _cover_needs(
     )
 
 
-def _held_slots(ctx: Ctx, a: MonitorAction) -> dict[str, int]:
+def _held_slots(ctx: Ctx, a: MonitorJob) -> dict[str, int]:
     """The slot of ``a`` each UAV flying one of its segments holds now: it
     goes on watching there first, and takes no other slot before that (never
     flown across the ring while a newcomer takes its place)."""
@@ -212,7 +212,7 @@ def _held_slots(ctx: Ctx, a: MonitorAction) -> dict[str, int]:
 
 def _offers(
     ctx: Ctx,
-    a: MonitorAction,
+    a: MonitorJob,
     pre: list[_Ranked],
     need: Need,
     pos: Vec3,
@@ -249,12 +249,12 @@ def _offers(
 
 
 def _commit_first(
-    ctx: Ctx, a: MonitorAction, offers: list[_Offer], need: Need, pos: Vec3
+    ctx: Ctx, a: MonitorJob, offers: list[_Offer], need: Need, pos: Vec3
 ) -> _Offer | None:
     """Commit the first of ``offers`` that simulates; None if none does."""
     t = need.start_s
     for offer in offers:
-        task = Task("monitor", a.id, need.slot, pos, offer.end_s - t, a.release_s, anchor_s=t)
+        task = Visit("monitor", a.id, need.slot, pos, offer.end_s - t, a.release_s, anchor_s=t)
         sim = ctx.try_insert(offer.uid, offer.position, [task])
         if not isinstance(sim, str):
             ctx.commit(offer.uid, offer.position, [task], sim)
@@ -262,7 +262,7 @@ def _commit_first(
     return None
 
 
-def repair(ctx: Ctx, a: MonitorAction, gaps: list[Need]) -> bool:
+def repair(ctx: Ctx, a: MonitorJob, gaps: list[Need]) -> bool:
     """Cover the needs a lost UAV leaves, without touching the rest of the
     monitoring; False (unchanged) if impossible."""
     snap = ctx.snapshot()
@@ -272,7 +272,7 @@ def repair(ctx: Ctx, a: MonitorAction, gaps: list[Need]) -> bool:
     return False
 
 
-def _keep_start(ctx: Ctx, a: MonitorAction, start_s: float, uids: list[str]) -> bool:
+def _keep_start(ctx: Ctx, a: MonitorJob, start_s: float, uids: list[str]) -> bool:
     """Commit a coverage from the promised ``start_s``; False (unchanged) if infeasible."""
     snap = ctx.snapshot()
     if _cover(ctx, a, start_s, uids) is not None:
@@ -281,7 +281,7 @@ def _keep_start(ctx: Ctx, a: MonitorAction, start_s: float, uids: list[str]) -> 
     return False
 
 
-def _complete_kept(ctx: Ctx, a: MonitorAction, uids: list[str]) -> bool:
+def _complete_kept(ctx: Ctx, a: MonitorJob, uids: list[str]) -> bool:
     """If segments of ``a`` are still planned (pinned ones an improvement
     round kept), cover only the slots without one over the kept segments'
     window, never a second coverage beside them; True if so (unplaced if
@@ -301,7 +301,7 @@ def _complete_kept(ctx: Ctx, a: MonitorAction, uids: list[str]) -> bool:
     return True
 
 
-def place_monitor(ctx: Ctx, a: MonitorAction) -> None:
+def place_monitor(ctx: Ctx, a: MonitorJob) -> None:
     """Cover ``a`` from the best start tried (a promised start stands unless
     a clearly earlier one works), or report it unplaced."""
     uids = ctx.capable("monitor")
@@ -337,7 +337,7 @@ def place_monitor(ctx: Ctx, a: MonitorAction) -> None:
     ctx.restore(best.snapshot)
 
 
-def _reachable(ctx: Ctx, a: MonitorAction, uids: list[str], min_seg: float) -> bool:
+def _reachable(ctx: Ctx, a: MonitorJob, uids: list[str], min_seg: float) -> bool:
     """Whether some UAV, on a full battery from the nearest station, could
     watch slot 0 for ``min_seg`` and get back above the reserve."""
     d = ctx.site.nearest(slot_position(a, 0)).distance_m
@@ -349,7 +349,7 @@ def _reachable(ctx: Ctx, a: MonitorAction, uids: list[str], min_seg: float) -> b
 
 
 def _best_coverage(
-    ctx: Ctx, a: MonitorAction, uids: list[str], ready: ReadyTimes, t0: float
+    ctx: Ctx, a: MonitorJob, uids: list[str], ready: ReadyTimes, t0: float
 ) -> _Coverage | None:
     """The cheapest coverage from the first candidate starts, or else from
     the first fallback start that works (``start_times``); the state is

@@ -12,7 +12,7 @@ from __future__ import annotations
 import heapq
 from collections.abc import Iterator
 
-from ground_station.planner.model import MonitorAction, slot_position
+from ground_station.planner.model import MonitorJob, slot_position
 from ground_station.planner.reach import direct_arrival, hold_floor_wh, monitor_ready
 from ground_station.planner.routes import Ctx
 
@@ -41,7 +41,7 @@ class ReadyTimes:
     """
 
     def __init__(
-        self, ctx: Ctx, a: MonitorAction, uids: list[str], base: float, min_seg_s: float
+        self, ctx: Ctx, a: MonitorJob, uids: list[str], base: float, min_seg_s: float
     ) -> None:
         self._ctx, self.base, self._duration_s = ctx, base, a.duration_s
         self._min_seg_s = min_seg_s
@@ -104,7 +104,7 @@ class ReadyTimes:
 
 
 def start_times(
-    ctx: Ctx, a: MonitorAction, ready: ReadyTimes, t0: float
+    ctx: Ctx, a: MonitorJob, ready: ReadyTimes, t0: float
 ) -> tuple[list[float], Iterator[float]]:
     """(first candidates, later fallbacks) for a coverage whose k-th earliest
     ready time is ``t0``; the fallbacks are generated only as far as needed."""
@@ -124,7 +124,7 @@ def start_times(
     return primary, _fallbacks(ctx, a, ready)
 
 
-def _fallbacks(ctx: Ctx, a: MonitorAction, ready: ReadyTimes) -> Iterator[float]:
+def _fallbacks(ctx: Ctx, a: MonitorJob, ready: ReadyTimes) -> Iterator[float]:
     j = a.k
     while (x := ready.nth(j)) is not None:
         yield x

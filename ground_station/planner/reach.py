@@ -7,7 +7,7 @@ from __future__ import annotations
 
 from math import dist
 
-from ground_station.planner.energy import EPS_S, EPS_WH, Kin, Site, recharge_time_s
+from ground_station.planner.energy import EPS_S, EPS_WH, Kin, SiteMap, recharge_time_s
 from ground_station.planner.model import Vec3
 from ground_station.planner.pads import Ignore, Pads
 from ground_station.planner.recharge import next_hop, recharge_option
@@ -16,7 +16,7 @@ from ground_station.planner.state import State
 
 
 def monitor_reach(
-    k: Kin, site: Site, pads: Pads, st: State, pos: Vec3, anchor: float, ign: Ignore, need: float
+    k: Kin, site: SiteMap, pads: Pads, st: State, pos: Vec3, anchor: float, ign: Ignore, need: float
 ) -> float | None:
     """Latest end a monitoring segment at ``pos`` starting at ``anchor`` can
     last until on ``st``'s battery (direct, after a recharge, or after hops
@@ -37,7 +37,7 @@ def monitor_reach(
 
 def monitor_ready(
     k: Kin,
-    site: Site,
+    site: SiteMap,
     pads: Pads,
     st: State,
     pos: Vec3,
@@ -76,14 +76,20 @@ def direct_arrival(k: Kin, st: State, pos: Vec3, release_s: float) -> tuple[floa
     return arr, e_wait - tr * k.speed_mps * k.wh_per_m
 
 
-def hold_floor_wh(k: Kin, site: Site, pos: Vec3, hold_s: float) -> float:
+def hold_floor_wh(k: Kin, site: SiteMap, pos: Vec3, hold_s: float) -> float:
     """Battery needed at ``pos`` to hover ``hold_s`` there and then reach the
     nearest station above the reserve."""
     return k.reserve_wh - EPS_WH + site.nearest(pos).distance_m * k.wh_per_m + k.hover_whps * hold_s
 
 
 def _hop(
-    k: Kin, site: Site, pads: Pads, st: State, pos: Vec3, ign: Ignore, latest: float | None = None
+    k: Kin,
+    site: SiteMap,
+    pads: Pads,
+    st: State,
+    pos: Vec3,
+    ign: Ignore,
+    latest: float | None = None,
 ) -> State | None:
     """The state on the pad after a recharge at the next station towards
     ``pos`` (``next_hop``), as ``advance`` would fly it; None if there is
@@ -104,7 +110,7 @@ def _hop(
 
 
 def _reach_once(
-    k: Kin, site: Site, pads: Pads, st: State, pos: Vec3, anchor: float, ign: Ignore, need: float
+    k: Kin, site: SiteMap, pads: Pads, st: State, pos: Vec3, anchor: float, ign: Ignore, need: float
 ) -> float | None:
     """``monitor_reach`` without hops: the latest end flying straight from
     ``st``, or after a recharge if that is needed for ``need``."""

@@ -15,7 +15,7 @@ from ground_station.planner.energy import (
     EPS_S,
     EPS_WH,
     Kin,
-    Site,
+    SiteMap,
     energy_after_recharge,
     recharge_time_s,
 )
@@ -48,7 +48,7 @@ class RcOption(NamedTuple):
 
 def recharge_option(
     k: Kin,
-    site: Site,
+    site: SiteMap,
     pads: Pads,
     st: State,
     target: Vec3,
@@ -85,7 +85,7 @@ def recharge_option(
 
 def _rc_best(
     k: Kin,
-    site: Site,
+    site: SiteMap,
     pads: Pads,
     st: State,
     target: Vec3,
@@ -151,7 +151,7 @@ def _rc_best(
 
 
 def emit_recharge(
-    k: Kin, site: Site, st: State, rc: RcOption, steps: list[Step], res: list[Booking]
+    k: Kin, site: SiteMap, st: State, rc: RcOption, steps: list[Step], res: list[Booking]
 ) -> State:
     """Append the flight to the pad (landing to wait for a free pad if needed)
     and the recharge; returns the state on the pad."""
@@ -191,7 +191,7 @@ def emit_recharge(
     return State(end, sp, rc.e_charged, True, tool)
 
 
-def next_hop(k: Kin, site: Site, st: State, target: Vec3) -> int | None:
+def next_hop(k: Kin, site: SiteMap, st: State, target: Vec3) -> int | None:
     """The reachable charging station nearest ``target`` and nearer than us."""
     d_from, d_to = site.dists(st.pos), site.dists(target)
     floor_wh = k.reserve_wh - EPS_WH

@@ -20,17 +20,17 @@ from ground_station.planner.energy import EPS_S, EPS_WH, energy_after_recharge
 from ground_station.planner.model import Vec3
 from ground_station.planner.result import Step
 from ground_station.planner.routes import Ctx
-from ground_station.planner.simulate import HOLDS, State, Task, hold_wait
+from ground_station.planner.simulate import HOLDS, State, Visit, hold_wait
 from ground_station.planner.state import Booking, wait_step
 
 
-def remove(ctx: Ctx, uid: str, pred: Callable[[Task], bool]) -> bool:
+def remove(ctx: Ctx, uid: str, pred: Callable[[Visit], bool]) -> bool:
     """Remove matching tasks from ``uid``'s route, re-simulating it or else
     keeping the other steps' times; False (unchanged) if neither works."""
     return ctx.remove_tasks(uid, pred) is not None or remove_in_place(ctx, uid, pred) is not None
 
 
-def remove_in_place(ctx: Ctx, uid: str, pred: Callable[[Task], bool]) -> list[Task] | None:
+def remove_in_place(ctx: Ctx, uid: str, pred: Callable[[Visit], bool]) -> list[Visit] | None:
     """Remove matching tasks keeping all other steps' times; None if the
     battery would break (the route is then unchanged)."""
     r = ctx.routes[uid]
@@ -40,8 +40,8 @@ def remove_in_place(ctx: Ctx, uid: str, pred: Callable[[Task], bool]) -> list[Ta
     replay = _Replay(ctx, uid)
     marks: list[int] = []
     states: list[State] = []
-    tasks: list[Task] = []
-    removed: list[Task] = []
+    tasks: list[Visit] = []
+    removed: list[Visit] = []
     last_kept = max((i for i, x in enumerate(r.tasks) if not pred(x)), default=-1)
     open_mark: int | None = None  # where the kept steps of removed tasks begin
     for i, task in enumerate(r.tasks):

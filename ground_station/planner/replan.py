@@ -19,9 +19,9 @@ from ground_station.planner.energy import Kin
 from ground_station.planner.errors import PlanningProblemError
 from ground_station.planner.export import export
 from ground_station.planner.load import check_problem
-from ground_station.planner.model import Action, InspectAction, MonitorAction, Problem, Uav, Vec3
+from ground_station.planner.model import InspectJob, Job, MonitorJob, Problem, Uav, Vec3
 from ground_station.planner.removal import remove
-from ground_station.planner.result import Plan
+from ground_station.planner.result import Solution
 from ground_station.planner.routes import (
     Ctx,
     Grounded,
@@ -30,17 +30,17 @@ from ground_station.planner.routes import (
     emergency_landing,
     queue_order,
 )
-from ground_station.planner.simulate import State, Task, simulate
+from ground_station.planner.simulate import State, Visit, simulate
 
 replace = msgspec.structs.replace
 
 
 class ActionAdded(msgspec.Struct, frozen=True, kw_only=True, tag=True):
-    action: Action
+    action: Job
 
 
 class ActionChanged(msgspec.Struct, frozen=True, kw_only=True, tag=True):
-    action: Action
+    action: Job
 
 
 class ActionCancelled(msgspec.Struct, frozen=True, kw_only=True, tag=True):
@@ -98,7 +98,7 @@ class Session:
         ctx = heuristic.build_until(problem, options, should_stop)
         return None if ctx is None else cls(problem, ctx=ctx)
 
-    def plan(self) -> Plan:
+    def plan(self) -> Solution:
         """The current plan."""
         return export(self.ctx)
 
@@ -141,12 +141,12 @@ class Session:
             if not self._pending:
                 return
             pending, self._pending = list(dict.fromkeys(self._pending)), []
-            whole: list[Action] = []
+            whole: list[Job] = []
             for aid in pending:
                 a = ctx.actions.get(aid)
                 if a is None:
                     continue
-                if isinstance(a, InspectAction):
+                if isinstance(a, InspectJob):
                     have = {
                         t.index for r in ctx.routes.values() for t in r.tasks if t.action_id == aid
                     }
@@ -168,17 +168,17 @@ class Session:
         uavs[self._uav_index(uav.id)] = uav
         self._set_problem(replace(self.problem, uavs=tuple(uavs)))
 
-    def _place(self, actions: list[Action]) -> None:
+    def _place(self, actions: list[Job]) -> None:
         for a in queue_order(actions):
             heuristic.place_action(self.ctx, a)
 
-    def _hold_points(self, a: Action) -> None:
+    def _hold_points(self, a: Job) -> None:
         """Register ``a``'s hold points; bookings of groups it merges move along."""
         for merged, joined in self.ctx.site.points.add_action(a):
             self.ctx.pads.merge(merged, joined)
 
     # -- events -------------------------------------------------------------------
-    def apply(self, event: Event) -> Plan:
+    def apply(self, event: Event) -> Solution:
         """Apply one event; returns the new plan. Raises ``PlanningProblemError``
         if the event refers to unknown things or makes the problem invalid."""
         ctx = self.ctx
@@ -234,7 +234,7 @@ class Session:
         self._replace_uav(
             replace(u, position_m=pos, energy_wh=e, airborne=True, tool=tool, running=running)
         )
-        if isinstance(a, InspectAction) and done.index is not None:
+        if isinstance(a, InspectJob) and done.index is not None:
             a2 = replace(a, done=tuple(sorted({*a.done, done.index})))
             acts = tuple(a2 if x.id == a.id else x for x in self.problem.actions)
             self._set_problem(replace(self.problem, actions=acts))
@@ -254,7 +254,7 @@ class Session:
         tail as a last resort), then re-insert them elsewhere."""
         ctx = self.ctx
         r = ctx.routes[uid]
-        dropped: dict[str, list[Task]] = {}
+        dropped: dict[str, list[Visit]] = {}
         tasks = list(r.tasks)
         for attempt in range(12):
             sim = simulate(r.kin, ctx.site, ctx.pads, init, tasks, (uid, -1e18))
@@ -275,7 +275,7 @@ class Session:
         ctx.pinned = {(a, i) for a, i in ctx.pinned if a not in dropped}
         for aid, lost in dropped.items():
             a = ctx.actions[aid]
-            if isinstance(a, MonitorAction):
+            if isinstance(a, MonitorJob):
                 if monitor.repair(ctx, a, monitor.segment_needs(lost)):
                     continue
                 self._strip(aid)
@@ -316,9 +316,9 @@ class Session:
             a = ctx.actions[aid]
             if aid in self._pending:
                 continue  # displaced meanwhile: re-planned whole by _flush
-            if isinstance(a, InspectAction):
+            if isinstance(a, InspectJob):
                 heuristic.place_inspect(ctx, a, idx)
-            elif isinstance(a, MonitorAction) and monitor.repair(
+            elif isinstance(a, MonitorJob) and monitor.repair(
                 ctx, a, monitor.segment_needs(t for t in r.tasks if t.action_id == aid)
             ):
                 continue
@@ -348,7 +348,7 @@ class Session:
             ctx.routes[u.id] = Route(kin, init)
         retry = [ctx.actions[aid] for aid in list(ctx.unplaced)]
         for a in retry:
-            if isinstance(a, InspectAction):
+            if isinstance(a, InspectJob):
                 parts = [x.part for x in ctx.unplaced.pop(a.id) if x.part is not None]
                 heuristic.place_inspect(ctx, a, parts)
             else:
@@ -369,7 +369,7 @@ class Session:
 
 def replan_once(
     problem: Problem, event: Event, options: Options | None = None
-) -> tuple[Problem, Plan]:
+) -> tuple[Problem, Solution]:
     """One-shot helper: plan ``problem``, apply ``event``; (new problem, plan).
 
     For repeated events keep a ``Session``: that is what makes a replan cheap.

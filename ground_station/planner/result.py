@@ -1,4 +1,4 @@
-"""Plan document types: what the planner returns.
+"""What the planner returns: a :class:`Solution`.
 
 Step semantics (shared with the validator): a step begins at ``start_s`` at
 the previous step's end position (or the UAV's position for its first
@@ -82,7 +82,7 @@ class Metrics(msgspec.Struct, frozen=True, kw_only=True):
     mean_completion_s: float = 0.0
 
 
-class Plan(msgspec.Struct, frozen=True, kw_only=True):
+class Solution(msgspec.Struct, frozen=True, kw_only=True):
     """Per-UAV step lists, what could not be placed, and metrics."""
 
     uavs: tuple[UavPlan, ...]

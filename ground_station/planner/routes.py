@@ -14,18 +14,18 @@ from typing import NamedTuple
 
 import msgspec
 
-from ground_station.planner.energy import Kin, Site
+from ground_station.planner.energy import Kin, SiteMap
 from ground_station.planner.model import (
-    Action,
     CostWeights,
-    DeliverAction,
-    InspectAction,
+    DeliverJob,
+    InspectJob,
+    Job,
     Problem,
     RunningTask,
 )
 from ground_station.planner.pads import Pads
 from ground_station.planner.result import Step, Unplaced
-from ground_station.planner.simulate import Sim, State, Task, simulate
+from ground_station.planner.simulate import Sim, State, Visit, simulate
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -56,7 +56,7 @@ class GapCache(NamedTuple):
     """Insertion positions worth trying in a route (``insertion.gap_positions``),
     valid while its task list is ``tasks`` and ``anywhere`` is unchanged."""
 
-    tasks: list[Task]
+    tasks: list[Visit]
     anywhere: bool
     positions: list[int]
 
@@ -69,7 +69,7 @@ class Route:
     def __init__(self, kin: Kin, init: State) -> None:
         self.kin = kin
         self.init = init
-        self.tasks: list[Task] = []
+        self.tasks: list[Visit] = []
         self.states: list[State] = []
         self.steps: list[Step] = []
         self.marks: list[int] = []
@@ -86,7 +86,7 @@ class RouteState(msgspec.Struct, frozen=True, gc=False):
     """A route's lists at a snapshot (they are replaced, never mutated)."""
 
     init: State
-    tasks: list[Task]
+    tasks: list[Visit]
     states: list[State]
     steps: list[Step]
     marks: list[int]
@@ -114,10 +114,10 @@ class Ctx:
 
     problem: Problem
     options: Options
-    site: Site
+    site: SiteMap
     routes: dict[str, Route]
     pads: Pads
-    actions: dict[str, Action]
+    actions: dict[str, Job]
     weights: CostWeights
     unplaced: dict[str, list[Unplaced]] = field(default_factory=dict)
     running: dict[str, RunningTask] = field(default_factory=dict)  # by UAV, in routes
@@ -126,7 +126,7 @@ class Ctx:
     fast: bool = False  # replanning: fewer alternatives per placement
     rng: random.Random | None = None  # improvement: randomised placement choices
     emergency: dict[str, Grounded] = field(default_factory=dict)
-    last_fail: Task | None = None  # the task that made the last removal fail
+    last_fail: Visit | None = None  # the task that made the last removal fail
 
     # -- drafts -----------------------------------------------------------
     def snapshot(self) -> Snapshot:
@@ -148,7 +148,7 @@ class Ctx:
         self.unplaced = {a: list(v) for a, v in unplaced.items()}
 
     # -- route edits --------------------------------------------------------
-    def try_insert(self, uid: str, pos: int, new: list[Task]) -> Sim | str:
+    def try_insert(self, uid: str, pos: int, new: list[Visit]) -> Sim | str:
         """Simulate ``new`` inserted at ``pos`` plus the suffix after it
         (stopping early where the suffix is unchanged)."""
         r = self.routes[uid]
@@ -159,13 +159,13 @@ class Ctx:
         old_map = [-1] * len(new) + list(range(pos, len(r.tasks)))
         return simulate(r.kin, self.site, self.pads, st, tasks, (uid, st.t), r.states, old_map)
 
-    def _resumed(self, uid: str) -> list[Task]:
+    def _resumed(self, uid: str) -> list[Visit]:
         """The route with its running first task turned into a normal one (a
         task that is interrupted is redone in full when resumed)."""
         r = self.routes[uid]
         return [r.tasks[0].resumed(), *r.tasks[1:]]
 
-    def try_preempt(self, uid: str, new: list[Task]) -> Sim | str:
+    def try_preempt(self, uid: str, new: list[Visit]) -> Sim | str:
         """Simulate ``new`` before the UAV's running task (J3 interruption)."""
         r = self.routes[uid]
         tasks = new + self._resumed(uid)
@@ -174,16 +174,16 @@ class Ctx:
             r.kin, self.site, self.pads, r.init, tasks, (uid, r.init.t), r.states, old_map
         )
 
-    def commit_preempt(self, uid: str, new: list[Task], sim: Sim) -> None:
+    def commit_preempt(self, uid: str, new: list[Visit], sim: Sim) -> None:
         """Apply ``try_preempt``; the interrupted task stays pinned to this UAV."""
         self._replace_suffix(uid, 0, new + self._resumed(uid), sim)
 
-    def commit(self, uid: str, pos: int, new: list[Task], sim: Sim) -> None:
+    def commit(self, uid: str, pos: int, new: list[Visit], sim: Sim) -> None:
         """Apply a successful ``try_insert``."""
         r = self.routes[uid]
         self._replace_suffix(uid, pos, new + r.tasks[pos:], sim)
 
-    def _replace_suffix(self, uid: str, pos: int, tasks: list[Task], sim: Sim) -> None:
+    def _replace_suffix(self, uid: str, pos: int, tasks: list[Visit], sim: Sim) -> None:
         """The route's tasks from ``pos`` become ``tasks`` as simulated by
         ``sim`` (if ``sim`` converged, the old route's tail is kept as is)."""
         r = self.routes[uid]
@@ -210,7 +210,7 @@ class Ctx:
             self.pads.remove_uav(uid, st.t, conv_t)
         self.pads.book(sim.res, uid)
 
-    def remove_tasks(self, uid: str, pred: Callable[[Task], bool]) -> list[Task] | None:
+    def remove_tasks(self, uid: str, pred: Callable[[Visit], bool]) -> list[Visit] | None:
         """Remove matching tasks and re-simulate; None (unchanged) if infeasible."""
         r = self.routes[uid]
         first = next((i for i, t in enumerate(r.tasks) if pred(t)), None)
@@ -218,7 +218,7 @@ class Ctx:
             return []
         removed = [t for t in r.tasks[first:] if pred(t)]
         last = max(i for i, t in enumerate(r.tasks) if pred(t))
-        keep: list[Task] = []
+        keep: list[Visit] = []
         old_map: list[int] = []
         for i in range(first, len(r.tasks)):
             if not pred(r.tasks[i]):
@@ -244,7 +244,7 @@ class Ctx:
         self._replace_suffix(uid, first, keep, sim)
         return removed
 
-    def remove_displacing(self, uid: str, pred: Callable[[Task], bool]) -> set[str]:
+    def remove_displacing(self, uid: str, pred: Callable[[Visit], bool]) -> set[str]:
         """Remove matching tasks; if a later task no longer fits, also remove
         that task's whole action from this route. Returns those displaced
         actions (the caller re-plans them); always succeeds."""
@@ -290,7 +290,7 @@ class Ctx:
         return [u for u, r in self.routes.items() if any(t.action_id == action_id for t in r.tasks)]
 
 
-def emergency_landing(problem: Problem, kin: Kin, st: State, site: Site) -> str | None:
+def emergency_landing(problem: Problem, kin: Kin, st: State, site: SiteMap) -> str | None:
     """The station to land at if the UAV cannot reach any station above the
     reserve (a battery fault); None if it can plan normally (including a UAV
     on a charging station, which just recharges first)."""
@@ -304,7 +304,7 @@ def emergency_landing(problem: Problem, kin: Kin, st: State, site: Site) -> str 
     return best.id
 
 
-def queue_order(actions: list[Action] | tuple[Action, ...]) -> list[Action]:
+def queue_order(actions: list[Job] | tuple[Job, ...]) -> list[Job]:
     """The paper's FCFS-by-weight queue: heavier first, then release, then input order."""
     order = sorted(range(len(actions)), key=lambda i: (-actions[i].weight, actions[i].release_s, i))
     return [actions[i] for i in order]
@@ -312,7 +312,7 @@ def queue_order(actions: list[Action] | tuple[Action, ...]) -> list[Action]:
 
 def new_ctx(problem: Problem, options: Options) -> Ctx:
     """Build routes for the available UAVs, with running tasks pinned first."""
-    site = Site(problem)
+    site = SiteMap(problem)
     types = {t.id: t for t in problem.uav_types}
     actions = {a.id: a for a in problem.actions}
     routes: dict[str, Route] = {}
@@ -341,12 +341,12 @@ def new_ctx(problem: Problem, options: Options) -> Ctx:
         act = actions[run.action_id]
         ctx.running[u.id] = run
         task = None
-        if isinstance(act, InspectAction):
+        if isinstance(act, InspectJob):
             wp = act.waypoints[run.index]
-            task = Task("inspect", act.id, run.index, wp.position_m, run.remaining_s)
+            task = Visit("inspect", act.id, run.index, wp.position_m, run.remaining_s)
             task.full_s = wp.service_s
-        elif isinstance(act, DeliverAction):
-            task = Task(
+        elif isinstance(act, DeliverJob):
+            task = Visit(
                 "deliver", act.id, None, act.worker_m, run.remaining_s or act.drop_s, tool=act.tool
             )
             task.full_s = act.drop_s

@@ -13,26 +13,26 @@ from __future__ import annotations
 
 from math import dist
 
-from ground_station.planner.energy import EPS_S, EPS_WH, Kin, Site
+from ground_station.planner.energy import EPS_S, EPS_WH, Kin, SiteMap
 from ground_station.planner.model import Vec3
 from ground_station.planner.pads import Ignore, Pads
 from ground_station.planner.recharge import emit_recharge, next_hop, recharge_option
 from ground_station.planner.result import Step
-from ground_station.planner.state import Booking, Fail, Sim, State, Task, wait_step
+from ground_station.planner.state import Booking, Fail, Sim, State, Visit, wait_step
 
-__all__ = ["Fail", "Sim", "State", "Task", "advance", "simulate"]
+__all__ = ["Fail", "Sim", "State", "Visit", "advance", "simulate"]
 
 MAX_HOPS = 12
 """Recursion bound of ``advance``: hops along stations and deferrals."""
 LONG_WAIT_S = 120.0
 """An airborne UAV facing a longer idle wait lands to recharge if it can."""
 HOLDS = frozenset({"inspect", "pick", "deliver"})
-"""Tasks that hold a point (``Site.points``) one UAV at a time: a second
+"""Tasks that hold a point (``SiteMap.points``) one UAV at a time: a second
 UAV waits until the first has left (an airborne wait there holds it too)."""
 
 
 def hold_wait(
-    site: Site,
+    site: SiteMap,
     pads: Pads,
     pos: Vec3,
     start: float,
@@ -57,10 +57,10 @@ def _service_end_e(k: Kin, e_at: float, service_s: float) -> float:
 
 def advance(
     k: Kin,
-    site: Site,
+    site: SiteMap,
     pads: Pads,
     st: State,
-    task: Task,
+    task: Visit,
     steps: list[Step],
     res: list[Booking],
     ign: Ignore,
@@ -172,7 +172,7 @@ def advance(
     return State(end, task.pos, e_end, False, tool)
 
 
-def _deadlines(k: Kin, tasks: list[Task]) -> list[float | None]:
+def _deadlines(k: Kin, tasks: list[Visit]) -> list[float | None]:
     """Latest arrival at each task that still lets the UAV reach the next
     anchored task in time (ignoring recharges); None if none follows."""
     out: list[float | None] = [None] * len(tasks)
@@ -189,10 +189,10 @@ def _deadlines(k: Kin, tasks: list[Task]) -> list[float | None]:
 
 def simulate(
     k: Kin,
-    site: Site,
+    site: SiteMap,
     pads: Pads,
     st: State,
-    tasks: list[Task],
+    tasks: list[Visit],
     ign: Ignore,
     old: list[State] | None = None,
     old_map: list[int] | None = None,

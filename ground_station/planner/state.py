@@ -18,7 +18,7 @@ from ground_station.planner.model import Vec3
 from ground_station.planner.result import Step, StepKind
 
 
-class Task:
+class Visit:
     """One schedulable job on a UAV (see ``simulate``)."""
 
     __slots__ = (
@@ -56,8 +56,8 @@ class Task:
         self.topup = False  # recharge before this task if at all possible
         self.full_s: float | None = None  # a running task's full service, if resumed later
 
-    def _with(self, service_s: float, release_s: float) -> Task:
-        return Task(
+    def _with(self, service_s: float, release_s: float) -> Visit:
+        return Visit(
             self.kind,
             self.action_id,
             self.index,
@@ -68,24 +68,24 @@ class Task:
             self.tool,
         )
 
-    def copy_topup(self) -> Task:
+    def copy_topup(self) -> Visit:
         """This task, recharging before it if at all possible."""
         t = self._with(self.service_s, self.release_s)
         t.topup, t.full_s = True, self.full_s
         return t
 
-    def released(self, release_s: float) -> Task:
+    def released(self, release_s: float) -> Visit:
         """This task, not to be started before ``release_s``."""
         t = self._with(self.service_s, release_s)
         t.topup, t.full_s = self.topup, self.full_s
         return t
 
-    def resumed(self) -> Task:
+    def resumed(self) -> Visit:
         """This running task redone in full (after a recharge or interruption)."""
         return self if self.full_s is None else self._with(self.full_s, self.release_s)
 
     def __repr__(self) -> str:
-        return f"Task({self.kind},{self.action_id},{self.index},{self.anchor_s})"
+        return f"Visit({self.kind},{self.action_id},{self.index},{self.anchor_s})"
 
 
 class Fail(str):

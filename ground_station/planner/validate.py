@@ -15,15 +15,15 @@ from math import dist
 
 from ground_station.planner.model import (
     WAIT_ASIDE_M,
-    Action,
-    DeliverAction,
-    InspectAction,
-    MonitorAction,
+    DeliverJob,
+    InspectJob,
+    Job,
+    MonitorJob,
     Problem,
     Uav,
     Vec3,
 )
-from ground_station.planner.result import Plan, Step, UavPlan, Violation
+from ground_station.planner.result import Solution, Step, UavPlan, Violation
 from ground_station.planner.validate_checks import (
     TOL_M,
     TOL_S,
@@ -41,10 +41,10 @@ from ground_station.planner.validate_checks import (
 
 STANDOFF_TOL_M = 0.5
 SERVICE_KIND = {"inspect": "inspect", "monitor": "monitor", "pick": "deliver", "deliver": "deliver"}
-KIND_OF = {InspectAction: "inspect", MonitorAction: "monitor", DeliverAction: "deliver"}
+KIND_OF = {InspectJob: "inspect", MonitorJob: "monitor", DeliverJob: "deliver"}
 
 
-def validate(problem: Problem, plan: Plan) -> list[Violation]:
+def validate(problem: Problem, plan: Solution) -> list[Violation]:
     """All violations of ``plan`` against ``problem`` (empty when valid)."""
     fleet = _Fleet(problem)
     for up in plan.uavs:
@@ -192,7 +192,7 @@ class _Replay:
         drop_s = None  # a running delivery may finish with its remaining drop time
         run = self.u.running
         if s.kind == "deliver" and run is not None and run.action_id == s.action_id and self.fresh:
-            drop_s = min(run.remaining_s, act.drop_s) if isinstance(act, DeliverAction) else None
+            drop_s = min(run.remaining_s, act.drop_s) if isinstance(act, DeliverJob) else None
         self._check_work(s, act, where, drop_s)
         if s.kind == "pick":
             self._pick(where, s)
@@ -216,20 +216,20 @@ class _Replay:
             self.rep.add("tool_not_at_station", f"{where}: no {s.tool!r} here", self.uid)
         self.tool = s.tool
 
-    def _deliver(self, where: str, s: Step, act: Action | None) -> None:
+    def _deliver(self, where: str, s: Step, act: Job | None) -> None:
         """A drop: with the action's tool in hand."""
-        want = act.tool if isinstance(act, DeliverAction) else None
+        want = act.tool if isinstance(act, DeliverJob) else None
         if self.tool is None or self.tool != want:
             detail = f"{where}: holds {self.tool!r}"
             self.rep.add("deliver_without_tool", detail, self.uid, s.action_id)
         self.fleet.delivered[s.action_id or ""] += 1
         self.tool = None
 
-    def _check_inspection(self, where: str, s: Step, act: Action | None, serve: float) -> None:
+    def _check_inspection(self, where: str, s: Step, act: Job | None, serve: float) -> None:
         """The waypoint's whole service time (or the running task's rest)."""
         run, index = self.u.running, s.index
         need = None
-        if isinstance(act, InspectAction) and index is not None and 0 <= index < len(act.waypoints):
+        if isinstance(act, InspectJob) and index is not None and 0 <= index < len(act.waypoints):
             need = act.waypoints[index].service_s
             if self.fresh and run is not None and (run.action_id, run.index) == (act.id, index):
                 need = min(need, run.remaining_s)  # continuing the running task
@@ -264,7 +264,7 @@ class _Replay:
         self.landed = True
 
     def _check_work(
-        self, s: Step, act: Action | None, where: str, drop_s: float | None = None
+        self, s: Step, act: Job | None, where: str, drop_s: float | None = None
     ) -> None:
         """A work step against its action: capability, release, altitude,
         then where and how long it works (``drop_s``: a running drop's rest)."""
@@ -280,22 +280,20 @@ class _Replay:
         if s.position_m[2] < self.fleet.problem.min_altitude_m - TOL_M:
             detail = f"{where}: z {s.position_m[2]:.1f} m below the minimum"
             self.rep.add("too_low", detail, uid, act.id)
-        if isinstance(act, InspectAction):
+        if isinstance(act, InspectJob):
             if s.index is None or not 0 <= s.index < len(act.waypoints):
                 self.rep.add("bad_index", f"{where}: waypoint index {s.index}", uid, act.id)
             elif dist(act.waypoints[s.index].position_m, s.position_m) > TOL_M:
                 self.rep.add("wrong_position", f"{where}: not at waypoint {s.index}", uid, act.id)
-        elif isinstance(act, MonitorAction):
+        elif isinstance(act, MonitorJob):
             if s.index is None or not 0 <= s.index < act.k:
                 self.rep.add("bad_index", f"{where}: slot {s.index}", uid, act.id)
             elif dist(slot_of(act, s.index), s.position_m) > STANDOFF_TOL_M:
                 self.rep.add("wrong_position", f"{where}: not at slot {s.index}", uid, act.id)
-        elif isinstance(act, DeliverAction):
+        elif isinstance(act, DeliverJob):
             self._check_delivery(s, act, where, drop_s)
 
-    def _check_delivery(
-        self, s: Step, act: DeliverAction, where: str, drop_s: float | None
-    ) -> None:
+    def _check_delivery(self, s: Step, act: DeliverJob, where: str, drop_s: float | None) -> None:
         """A pick or drop: the action's tool, the drop at the worker, long enough."""
         uid = self.uid
         if s.tool != act.tool:
@@ -310,7 +308,7 @@ class _Replay:
 
 
 def _hold_point(
-    s: Step, before: Step | None, actions: dict[str, Action], at_station: bool, landed: bool
+    s: Step, before: Step | None, actions: dict[str, Job], at_station: bool, landed: bool
 ) -> Vec3 | None:
     """Where step ``s`` hovers (None if it does not): its position for work,
     an airborne wait's too, or aside of the slot it follows (``WAIT_ASIDE_M``)."""
@@ -320,6 +318,6 @@ def _hold_point(
         return None
     if before is not None and before.kind == "monitor" and before.index is not None:
         act = actions.get(before.action_id) if before.action_id is not None else None
-        if isinstance(act, MonitorAction):
+        if isinstance(act, MonitorJob):
             return slot_of(act, before.index, WAIT_ASIDE_M)
     return s.position_m

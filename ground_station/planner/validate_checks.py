@@ -10,15 +10,15 @@ from math import cos, dist, pi, radians, sin
 from typing import NamedTuple
 
 from ground_station.planner.model import (
-    DeliverAction,
-    InspectAction,
-    MonitorAction,
+    DeliverJob,
+    InspectJob,
+    MonitorJob,
     Problem,
     Station,
     Uav,
     Vec3,
 )
-from ground_station.planner.result import Plan, Step, Violation
+from ground_station.planner.result import Solution, Step, Violation
 
 TOL_S = 1e-3
 TOL_WH = 1e-3
@@ -59,7 +59,7 @@ class Report:
         self.items.append(Violation(code=code, detail=detail, uav_id=uav, action_id=action))
 
 
-def slot_of(act: MonitorAction, slot: int, aside_m: float = 0.0) -> tuple[float, float, float]:
+def slot_of(act: MonitorJob, slot: int, aside_m: float = 0.0) -> tuple[float, float, float]:
     """Where slot ``slot`` is, from the action's definition (not the
     planner's code); ``aside_m`` along the ring (counter-clockwise)."""
     x, y, z = act.worker_m
@@ -128,7 +128,7 @@ def check_separation(rep: Report, separation_m: float, holds: list[Hold]) -> Non
 def check_actions(
     rep: Report,
     problem: Problem,
-    plan: Plan,
+    plan: Solution,
     monitor_iv: dict[str, list[Segment]],
     waypoints: dict[str, list[int]],
     delivered: dict[str, int],
@@ -140,18 +140,18 @@ def check_actions(
         unplaced[x.action_id].add(x.part)
     for a in problem.actions:
         whole_unplaced = None in unplaced[a.id]
-        if isinstance(a, InspectAction):
+        if isinstance(a, InspectJob):
             _check_waypoints(rep, a, waypoints.get(a.id, []), unplaced[a.id])
-        elif isinstance(a, DeliverAction):
+        elif isinstance(a, DeliverJob):
             expect = 0 if whole_unplaced else 1
             if delivered.get(a.id, 0) != expect:
                 rep.add("deliver_count", f"delivered {delivered.get(a.id, 0)} times", action=a.id)
-        elif isinstance(a, MonitorAction):
+        elif isinstance(a, MonitorJob):
             _check_monitoring(rep, a, monitor_iv.get(a.id, []), whole_unplaced)
 
 
 def _check_waypoints(
-    rep: Report, a: InspectAction, inspected: list[int], unplaced: set[int | None]
+    rep: Report, a: InspectJob, inspected: list[int], unplaced: set[int | None]
 ) -> None:
     """Each waypoint inspected once, unless done or unplaced."""
     counts: dict[int, int] = defaultdict(int)
@@ -164,9 +164,7 @@ def _check_waypoints(
             rep.add(code, f"waypoint {i} inspected {counts[i]} times", action=a.id)
 
 
-def _check_monitoring(
-    rep: Report, a: MonitorAction, ivs: list[Segment], whole_unplaced: bool
-) -> None:
+def _check_monitoring(rep: Report, a: MonitorJob, ivs: list[Segment], whole_unplaced: bool) -> None:
     """All slots start together (T0) and stay covered for ``duration_s``."""
     if whole_unplaced:
         if ivs:
@@ -182,7 +180,7 @@ def _check_monitoring(
         _check_slot(rep, a, slot, t0, sorted(seg for seg in ivs if seg.slot == slot))
 
 
-def _check_slot(rep: Report, a: MonitorAction, slot: int, t0: float, mine: list[Segment]) -> None:
+def _check_slot(rep: Report, a: MonitorJob, slot: int, t0: float, mine: list[Segment]) -> None:
     """Slot ``slot``'s segments (``mine``, by start) cover it from ``t0`` on."""
     if not mine or mine[0].start_s > t0 + TOL_S:
         rep.add("monitor_not_synchronised", f"slot {slot} not started at T0", action=a.id)

@@ -27,7 +27,7 @@ from typing import Any
 import msgspec
 
 from ground_station.planner.api import plan, score
-from ground_station.planner.model import DeliverAction, MonitorAction, Problem
+from ground_station.planner.model import DeliverJob, MonitorJob, Problem
 from ground_station.planner.replan import (
     ActionAdded,
     ActionCancelled,
@@ -39,7 +39,7 @@ from ground_station.planner.replan import (
     UavBack,
     UavLost,
 )
-from ground_station.planner.result import Plan
+from ground_station.planner.result import Solution
 from ground_station.planner.routes import Options
 from ground_station.planner.validate import validate
 from linecrew.planner_tools.bench_reference import best_known, deadline, references
@@ -58,13 +58,13 @@ def calibration_ms() -> float:
     return (time.perf_counter() - t0) * 1000.0
 
 
-def _timed(fn: Callable[[], Plan]) -> tuple[Plan, float]:
+def _timed(fn: Callable[[], Solution]) -> tuple[Solution, float]:
     t0 = time.perf_counter()
     out = fn()
     return out, (time.perf_counter() - t0) * 1000.0
 
 
-def _quality(p: Plan) -> dict[str, float]:
+def _quality(p: Solution) -> dict[str, float]:
     m = p.metrics
     return {
         "score": score(p)[1],
@@ -86,9 +86,9 @@ def _next_event(s: Session, rng: random.Random, pool: list, n: int) -> Event | N
     live = sorted(s.ctx.routes)
     if kind == "add" or not problem.actions:
         a = pool[n % len(pool)]
-        if isinstance(a, DeliverAction) and a.tool_station not in tool_stations(problem):
+        if isinstance(a, DeliverJob) and a.tool_station not in tool_stations(problem):
             a = msgspec.structs.replace(a, tool_station=problem.tool_stations[0].id)
-        if isinstance(a, MonitorAction):
+        if isinstance(a, MonitorJob):
             bearing = ring_bearing(problem.actions, a.worker_m, a.k)
             a = msgspec.structs.replace(a, bearing_deg=bearing)
         return ActionAdded(action=msgspec.structs.replace(a, id=f"ev{n}"))

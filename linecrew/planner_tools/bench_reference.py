@@ -18,7 +18,7 @@ from typing import Any
 
 from ground_station.planner.api import plan, score
 from ground_station.planner.model import Problem
-from ground_station.planner.result import Plan
+from ground_station.planner.result import Solution
 from ground_station.planner.routes import Options
 
 SEARCH_SEEDS = 3
@@ -32,10 +32,10 @@ def deadline(ms: float) -> Callable[[], bool]:
 
 
 def references(
-    problem: Problem, improved: Plan, paper: Plan, budget_ms: float, cpsat: bool
-) -> tuple[dict[str, Plan], dict[str, Any]]:
+    problem: Problem, improved: Solution, paper: Solution, budget_ms: float, cpsat: bool
+) -> tuple[dict[str, Solution], dict[str, Any]]:
     """Each reference's plan by kind, and the CP-SAT statuses and bounds."""
-    plans: dict[str, Plan] = {
+    plans: dict[str, Solution] = {
         "search": min(
             (
                 plan(problem, should_stop=deadline(budget_ms / SEARCH_SEEDS), seed=k)
@@ -66,7 +66,7 @@ def references(
     return plans, info
 
 
-def best_known(plans: dict[str, Plan], info: dict[str, Any]) -> dict[str, Any]:
+def best_known(plans: dict[str, Solution], info: dict[str, Any]) -> dict[str, Any]:
     """The best reference: its kind and plan, the score CP-SAT proved optimal
     for its model (``optimum``, None if unproven) and the best lower bound."""
     kind = min(plans, key=lambda k: score(plans[k]))

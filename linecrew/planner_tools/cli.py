@@ -20,7 +20,7 @@ from ground_station.planner.errors import PlanningProblemError
 from ground_station.planner.load import plan_from_json, problem_from_json, problem_from_obj
 from ground_station.planner.metrics import compute_metrics
 from ground_station.planner.model import Problem
-from ground_station.planner.result import Plan
+from ground_station.planner.result import Solution
 from ground_station.planner.routes import Options
 from ground_station.planner.validate import validate
 from linecrew.planner_tools.gantt import gantt, unplaced_table
@@ -43,7 +43,7 @@ def deadline(ms: float) -> tuple[object, float]:
     return (lambda: time.perf_counter() >= end), end
 
 
-def metrics_table(p: Plan) -> Table:
+def metrics_table(p: Solution) -> Table:
     m = p.metrics
     table = Table(title="Metrics")
     table.add_column("metric")

@@ -5,7 +5,7 @@ from __future__ import annotations
 from rich.table import Table
 from rich.text import Text
 
-from ground_station.planner.result import Plan, Unplaced
+from ground_station.planner.result import Solution, Unplaced
 
 GLYPH = {
     "inspect": ("I", "green"),
@@ -18,7 +18,7 @@ GLYPH = {
 }
 
 
-def gantt(plan: Plan, now_s: float = 0.0, width: int = 72) -> Table:
+def gantt(plan: Solution, now_s: float = 0.0, width: int = 72) -> Table:
     """One row per UAV; a column is ``span / width`` seconds; ``-`` is flight."""
     end = max((u.steps[-1].end_s for u in plan.uavs if u.steps), default=now_s + 1.0)
     span = max(end - now_s, 1e-9)

@@ -22,22 +22,22 @@ from collections.abc import Iterable
 from math import sin
 
 from ground_station.planner.model import (
-    Action,
-    DeliverAction,
-    InspectAction,
-    MonitorAction,
+    Airframe,
+    DeliverJob,
+    InspectJob,
+    Job,
+    MonitorJob,
     Problem,
     Station,
-    ToolStation,
+    ToolDepot,
     Uav,
-    UavType,
     Vec3,
-    Waypoint,
+    Viewpoint,
 )
 
 TOOLS = ("hammer", "wrench", "multimeter", "pliers", "insulator_tester")
 TYPES = (
-    UavType(
+    Airframe(
         id="physical",
         capabilities={"deliver": 0.0, "inspect": 1.0, "monitor": 1.0},
         cruise_speed_mps=10.0,
@@ -45,7 +45,7 @@ TYPES = (
         flight_power_w=300.0,
         hover_power_w=280.0,
     ),
-    UavType(
+    Airframe(
         id="inspection",
         capabilities={"inspect": 0.0, "monitor": 0.5},
         cruise_speed_mps=14.0,
@@ -53,7 +53,7 @@ TYPES = (
         flight_power_w=220.0,
         hover_power_w=200.0,
     ),
-    UavType(
+    Airframe(
         id="safety",
         capabilities={"monitor": 0.0, "inspect": 0.5},
         cruise_speed_mps=12.0,
@@ -77,7 +77,7 @@ def _apart_deg(a: float, b: float) -> float:
     return min(d, 360.0 - d)
 
 
-def ring_bearing(actions: Iterable[Action], worker_m: Vec3, k: int = 1) -> float:
+def ring_bearing(actions: Iterable[Job], worker_m: Vec3, k: int = 1) -> float:
     """A bearing for one more ``k``-UAV monitoring of the worker at
     ``worker_m`` that keeps its slots farthest from those of the worker's
     monitors in ``actions`` (the smallest angle maximised, as the ground
@@ -85,7 +85,7 @@ def ring_bearing(actions: Iterable[Action], worker_m: Vec3, k: int = 1) -> float
     taken = [
         b
         for a in actions
-        if isinstance(a, MonitorAction) and a.worker_m == worker_m
+        if isinstance(a, MonitorJob) and a.worker_m == worker_m
         for b in _slots_deg(a.bearing_deg, a.k)
     ]
     if not taken:
@@ -167,7 +167,7 @@ def generate(n_uavs: int, n_actions: int, seed: int = 0, family: str = "corridor
             )
         )
     tool_stations = [
-        ToolStation(
+        ToolDepot(
             id=f"T{i}",
             position_m=(stations[i].position_m[0] + 30.0, stations[i].position_m[1], 2.0),
             tools=TOOLS,
@@ -187,7 +187,7 @@ def generate(n_uavs: int, n_actions: int, seed: int = 0, family: str = "corridor
                 energy_wh=round(utype.battery_wh * rng.uniform(0.6, 1.0), 2),
             )
         )
-    actions: list[Action] = []
+    actions: list[Job] = []
     for i in range(n_actions):
         r = rng.random()
         weight = float(rng.randint(1, 5))
@@ -197,7 +197,7 @@ def generate(n_uavs: int, n_actions: int, seed: int = 0, family: str = "corridor
             n_wp = rng.randint(3, min(10, n_towers))
             start = max(0, min(centre, n_towers - n_wp))
             wps = tuple(
-                Waypoint(
+                Viewpoint(
                     position_m=(
                         towers[j][0] + rng.uniform(-8, 8),
                         towers[j][1] + 10.0,
@@ -208,13 +208,13 @@ def generate(n_uavs: int, n_actions: int, seed: int = 0, family: str = "corridor
                 for j in range(start, start + n_wp)
             )
             actions.append(
-                InspectAction(id=f"A{i:03d}", weight=weight, release_s=release, waypoints=wps)
+                InspectJob(id=f"A{i:03d}", weight=weight, release_s=release, waypoints=wps)
             )
         elif r < fam.mix[1]:
             tx, ty, tz = towers[centre]
             k = _k(fam, rng, n_uavs)
             actions.append(
-                MonitorAction(
+                MonitorJob(
                     bearing_deg=ring_bearing(actions, (tx, ty, tz - 5.0), k),
                     id=f"A{i:03d}",
                     weight=weight,
@@ -229,7 +229,7 @@ def generate(n_uavs: int, n_actions: int, seed: int = 0, family: str = "corridor
             tx, ty, tz = towers[centre]
             ts = min(tool_stations, key=lambda s: abs(s.position_m[0] - tx))
             actions.append(
-                DeliverAction(
+                DeliverJob(
                     id=f"A{i:03d}",
                     weight=weight,
                     release_s=release,

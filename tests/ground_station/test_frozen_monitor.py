@@ -13,15 +13,15 @@ import msgspec
 import pytest
 
 from ground_station.live_plan import LivePlan
-from ground_station.planner import Plan, Problem, validate
+from ground_station.planner import Problem, Solution, validate
 from ground_station.planner.export import export
 from ground_station.planner.heuristic import build
 from ground_station.planner.improve import improve
-from ground_station.planner.model import MonitorAction
+from ground_station.planner.model import MonitorJob
 from linecrew.planner_tools.generator import generate
 
 
-def doubled(plan: Plan) -> list[tuple]:
+def doubled(plan: Solution) -> list[tuple]:
     """Pairs of segments of one slot that overlap (on station) by over 1 s."""
     segments = collections.defaultdict(list)
     for uav in plan.uavs:
@@ -38,7 +38,7 @@ def doubled(plan: Plan) -> list[tuple]:
 
 
 def slot_zero_of_each_monitor(problem: Problem) -> set[tuple[str, int | None]]:
-    return {(a.id, 0) for a in problem.actions if isinstance(a, MonitorAction)}
+    return {(a.id, 0) for a in problem.actions if isinstance(a, MonitorJob)}
 
 
 @pytest.mark.parametrize(("problem_seed", "seed"), [(7, 2), (14, 0), (14, 1), (14, 2)])
@@ -59,8 +59,7 @@ def test_the_live_plan_improves_around_a_frozen_segment_without_a_second_coverag
 def test_a_two_uav_monitor_with_one_slot_frozen_gets_its_other_slot_in_step(problem_seed, seed):
     problem = generate(5, 12, problem_seed)
     actions = tuple(
-        msgspec.structs.replace(a, k=2) if isinstance(a, MonitorAction) else a
-        for a in problem.actions
+        msgspec.structs.replace(a, k=2) if isinstance(a, MonitorJob) else a for a in problem.actions
     )
     problem = msgspec.structs.replace(problem, actions=actions)
     ctx = build(problem)

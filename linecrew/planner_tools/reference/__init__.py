@@ -43,7 +43,7 @@ import msgspec
 
 from ground_station.planner.api import score
 from ground_station.planner.model import Problem
-from ground_station.planner.result import Plan
+from ground_station.planner.result import Solution
 from linecrew.planner_tools.reference.cpsat import Model
 from linecrew.planner_tools.reference.nodes import TICK_S, build_nodes, unsupported
 from linecrew.planner_tools.reference.steps import export, route_literals
@@ -62,7 +62,7 @@ class Reference(msgspec.Struct, frozen=True, kw_only=True):
 
     status: str
     detail: str = ""
-    plan: Plan | None = None
+    plan: Solution | None = None
     score_bound: float = 0.0
     wall_s: float = 0.0
     hinted: bool = False
@@ -79,7 +79,7 @@ SEED_MAX_S = 20.0
 
 
 def solve(
-    problem: Problem, time_limit_s: float = 30.0, workers: int = 2, hint: Plan | None = None
+    problem: Problem, time_limit_s: float = 30.0, workers: int = 2, hint: Solution | None = None
 ) -> Reference:
     """Solve ``problem`` with CP-SAT within ``time_limit_s`` seconds.
 
@@ -119,7 +119,7 @@ def solve(
     return out
 
 
-def _seed(m: Model, solver: CpSolver, hint: Plan, limit_s: float) -> bool:
+def _seed(m: Model, solver: CpSolver, hint: Solution, limit_s: float) -> bool:
     """Time ``hint``'s routes in the model and hint that whole solution."""
     lits = route_literals(m, hint)
     if lits is None:

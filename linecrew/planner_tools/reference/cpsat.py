@@ -5,7 +5,7 @@ from __future__ import annotations
 from math import ceil, dist
 from typing import TYPE_CHECKING
 
-from ground_station.planner.model import MonitorAction, Problem, Uav
+from ground_station.planner.model import MonitorJob, Problem, Uav
 from linecrew.planner_tools.reference.nodes import Node, clusters, nodes_of, ticks, units
 
 if TYPE_CHECKING:
@@ -35,7 +35,7 @@ class Model:
         self.segments = segments
         self.types = {t.id: t for t in problem.uav_types}
         self.model = md = cp.CpModel()
-        self.monitors = {a.id: a for a in problem.actions if isinstance(a, MonitorAction)}
+        self.monitors = {a.id: a for a in problem.actions if isinstance(a, MonitorJob)}
         self.horizon = horizon = ticks(horizon_s) if horizon_s else self._horizon()
         n = len(nodes)
         self.start = [md.new_int_var(0, horizon, f"s{j}") for j in range(n)]
@@ -59,7 +59,7 @@ class Model:
     def _horizon(self) -> int:
         p = self.problem
         span = sum(n.service_s for n in self.nodes) + sum(
-            a.duration_s for a in p.actions if isinstance(a, MonitorAction)
+            a.duration_s for a in p.actions if isinstance(a, MonitorJob)
         )
         far = max((dist(a.pos, b.pos) for a in self.nodes for b in self.nodes), default=0.0) + max(
             (dist(u.position_m, n.pos) for u in p.uavs for n in self.nodes), default=0.0
@@ -326,7 +326,7 @@ class Model:
         for a in self.problem.actions:
             w = round(a.weight * WEIGHT_SCALE)
             self.total_weight += w
-            if isinstance(a, MonitorAction):
+            if isinstance(a, MonitorJob):
                 terms.append(w * (self.t0[a.id] + ticks(a.duration_s)))
                 continue
             done = [

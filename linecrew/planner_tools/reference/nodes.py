@@ -7,9 +7,9 @@ from math import ceil, dist
 from typing import Literal
 
 from ground_station.planner.model import (
-    DeliverAction,
-    InspectAction,
-    MonitorAction,
+    DeliverJob,
+    InspectJob,
+    MonitorJob,
     Problem,
     Station,
     Vec3,
@@ -69,20 +69,20 @@ def build_nodes(problem: Problem) -> tuple[list[Node], dict[tuple[str, int], lis
     tools = {t.id: t for t in problem.tool_stations}
     for a in problem.actions:
         rel = ticks(a.release_s - problem.now_s) if a.release_s > problem.now_s else 0
-        if isinstance(a, InspectAction):
+        if isinstance(a, InspectJob):
             for i, w in enumerate(a.waypoints):
                 if i not in a.done:
                     nodes.append(
                         Node("inspect", w.position_m, ticks(w.service_s), a.id, i, release_s=rel)
                     )
-        elif isinstance(a, MonitorAction):
+        elif isinstance(a, MonitorJob):
             for slot in range(a.k):
                 segments[(a.id, slot)] = list(range(len(nodes), len(nodes) + SEGMENTS))
                 pos = slot_position(a, slot)
                 nodes.extend(
                     Node("monitor", pos, 0, a.id, slot, release_s=rel) for _ in range(SEGMENTS)
                 )
-        elif isinstance(a, DeliverAction):
+        elif isinstance(a, DeliverJob):
             where = tools[a.tool_station].position_m
             nodes.append(Node("pick", where, ticks(a.pick_s), a.id, tool=a.tool, release_s=rel))
             nodes.append(Node("deliver", a.worker_m, ticks(a.drop_s), a.id, tool=a.tool))

@@ -8,8 +8,8 @@ from typing import TYPE_CHECKING, TypedDict, Unpack
 import msgspec
 
 from ground_station.planner.metrics import compute_metrics
-from ground_station.planner.model import Station, Uav, UavType, Vec3
-from ground_station.planner.result import Plan, Step, StepKind, UavPlan
+from ground_station.planner.model import Airframe, Station, Uav, Vec3
+from ground_station.planner.result import Solution, Step, StepKind, UavPlan
 from linecrew.planner_tools.reference.cpsat import Model
 from linecrew.planner_tools.reference.nodes import TICK_S, Node, ticks
 
@@ -26,10 +26,10 @@ class _Refs(TypedDict, total=False):
     tool: str | None
 
 
-def export(m: Model, solver: CpSolver) -> Plan:
+def export(m: Model, solver: CpSolver) -> Solution:
     """The solution as a plan document (times and energy in floats)."""
     uavs = tuple(UavPlan(uav_id=u.id, steps=tuple(_steps(m, solver, u))) for u in m.problem.uavs)
-    plan = Plan(uavs=uavs)
+    plan = Solution(uavs=uavs)
     return msgspec.structs.replace(plan, metrics=compute_metrics(m.problem, plan))
 
 
@@ -51,7 +51,7 @@ def _steps(m: Model, solver: CpSolver, u: Uav) -> list[Step]:
 class _Run:
     """Builds one UAV's steps from its visits, tracking time and energy."""
 
-    def __init__(self, u: Uav, t: UavType, now: float) -> None:
+    def __init__(self, u: Uav, t: Airframe, now: float) -> None:
         self.t = t
         self.pos, self.time, self.e = u.position_m, now, u.energy_wh
         self.landed = not u.airborne
@@ -113,7 +113,7 @@ class _Run:
         self._step("home", self.time + tt, self.time + tt, home.position_m, d, station=home.id)
 
 
-def route_literals(m: Model, plan: Plan) -> list[LiteralT] | None:
+def route_literals(m: Model, plan: Solution) -> list[LiteralT] | None:
     """Literals fixing the routes of ``plan`` (every arc on or off), or None
     if the model cannot express them."""
     seqs = _sequences(m, plan)
@@ -126,7 +126,7 @@ def route_literals(m: Model, plan: Plan) -> list[LiteralT] | None:
     return out
 
 
-def _sequences(m: Model, plan: Plan) -> dict[str, list[int]] | None:
+def _sequences(m: Model, plan: Solution) -> dict[str, list[int]] | None:
     """Per UAV, the model nodes its steps visit in order (None if
     inexpressible). Monitoring steps of a slot map to its segments
     in time order across UAVs."""

@@ -10,11 +10,11 @@ import pytest
 import yaml
 
 from ground_station.planner import (
-    InspectAction,
-    MonitorAction,
+    InspectJob,
+    MonitorJob,
     PlanningProblemError,
     Problem,
-    Waypoint,
+    Viewpoint,
     plan,
     plan_from_json,
     problem_from_json,
@@ -87,7 +87,7 @@ def test_bad_json_documents() -> None:
 
 
 def test_k_larger_than_fleet_is_unplaced(fig6: Problem) -> None:
-    big = MonitorAction(id="big", worker_m=(0.0, 10.0, 3.0), k=3, duration_s=60.0)
+    big = MonitorJob(id="big", worker_m=(0.0, 10.0, 3.0), k=3, duration_s=60.0)
     problem = replace(fig6, actions=(*fig6.actions, big))
     result = plan(problem)
     assert validate(problem, result) == []
@@ -96,11 +96,11 @@ def test_k_larger_than_fleet_is_unplaced(fig6: Problem) -> None:
 
 
 def test_unreachable_waypoint_is_unplaced_and_the_rest_planned(fig6: Problem) -> None:
-    far = InspectAction(
+    far = InspectJob(
         id="far",
         waypoints=(
-            Waypoint(position_m=(5.0, 5.0, 3.0), service_s=5.0),
-            Waypoint(position_m=(5000.0, 0.0, 3.0), service_s=5.0),
+            Viewpoint(position_m=(5.0, 5.0, 3.0), service_s=5.0),
+            Viewpoint(position_m=(5000.0, 0.0, 3.0), service_s=5.0),
         ),
     )
     problem = replace(fig6, actions=(*fig6.actions, far))

@@ -7,15 +7,15 @@ import msgspec
 import pytest
 
 from ground_station.planner import (
-    InspectAction,
-    Plan,
+    Airframe,
+    InspectJob,
     PlanningProblemError,
     Problem,
+    Solution,
     Station,
     Uav,
     UavPlan,
-    UavType,
-    Waypoint,
+    Viewpoint,
     plan,
     problem_from_obj,
     validate,
@@ -24,7 +24,7 @@ from linecrew.planner_tools.generator import generate
 
 replace = msgspec.structs.replace
 # 0.01 Wh/m, 40 Wh above the reserve: 4 km on a full battery.
-TYPE = UavType(
+TYPE = Airframe(
     id="t",
     capabilities={"inspect": 0.0},
     cruise_speed_mps=10.0,
@@ -42,12 +42,12 @@ def corridor(end: str = "home", work_x: float = 12500.0, pads: int = 1) -> Probl
         for i in range(5)
     )
     uav = Uav(id="U0", type="t", position_m=(0.0, 0.0, 0.0), home_station="S0", energy_wh=50.0)
-    point = Waypoint(position_m=(work_x, 0.0, 20.0), service_s=30.0)
-    work = InspectAction(id="A", waypoints=(point,))
+    point = Viewpoint(position_m=(work_x, 0.0, 20.0), service_s=30.0)
+    work = InspectJob(id="A", waypoints=(point,))
     return Problem(stations=stations, uav_types=(TYPE,), uavs=(uav,), actions=(work,), end=end)  # type: ignore[arg-type]
 
 
-def after_work(p: Plan, uav: int = 0) -> list:
+def after_work(p: Solution, uav: int = 0) -> list:
     """The steps after the UAV's last piece of work."""
     steps = p.uavs[uav].steps
     last = max(i for i, s in enumerate(steps) if s.action_id is not None)
@@ -70,7 +70,7 @@ def test_a_plan_ending_away_from_home_is_flagged() -> None:
     p = plan(problem)
     steps = list(p.uavs[0].steps)
     cut = max(i for i, s in enumerate(steps) if s.kind == "recharge")
-    away = Plan(uavs=(UavPlan(uav_id="U0", steps=tuple(steps[: cut + 1])),))
+    away = Solution(uavs=(UavPlan(uav_id="U0", steps=tuple(steps[: cut + 1])),))
     assert {v.code for v in validate(problem, away)} >= {"not_home"}
     assert validate(replace(problem, end="any_station"), away) == []
 
@@ -92,12 +92,12 @@ def parked(end: str, pads: int = 1) -> Problem:
 
 
 def test_two_uavs_parked_on_one_pad_are_flagged() -> None:
-    idle = Plan(uavs=(UavPlan(uav_id="U0"), UavPlan(uav_id="U1")))
+    idle = Solution(uavs=(UavPlan(uav_id="U0"), UavPlan(uav_id="U1")))
     assert {v.code for v in validate(parked("any_station"), idle)} == {"pad_capacity"}
     assert [v.code for v in validate(parked("home"), idle)] == ["not_home", "not_home"]
     hovering = parked("any_station")
     hovering = replace(hovering, uavs=(replace(hovering.uavs[0], airborne=True),))
-    assert [v.code for v in validate(hovering, Plan(uavs=idle.uavs[:1]))] == ["end_station"]
+    assert [v.code for v in validate(hovering, Solution(uavs=idle.uavs[:1]))] == ["end_station"]
 
 
 def test_any_station_parks_but_never_on_a_stations_last_pad() -> None:

@@ -12,5 +12,5 @@ def test_all_is_sorted_and_resolvable() -> None:
 
 
 def test_core_api_is_exported() -> None:
-    for name in ("plan", "validate", "Session", "Problem", "Plan", "PlanningProblemError"):
+    for name in ("plan", "validate", "Session", "Problem", "Solution", "PlanningProblemError"):
         assert name in planner.__all__

@@ -6,7 +6,7 @@ import msgspec
 import pytest
 
 from ground_station.planner import Problem, RunningTask, plan, validate
-from ground_station.planner.model import MonitorAction, slot_position
+from ground_station.planner.model import MonitorJob, slot_position
 
 replace = msgspec.structs.replace
 
@@ -15,7 +15,7 @@ def _watching(paper: Problem, slot: int, bearing_deg: float) -> Problem:
     """uav1 watches ``slot`` of a k = 2 watch with 57 s left when the UAV on
     the other slot is gone (uav3 failed): uav2 comes from its pad, and uav1
     also has two deliveries to make (it is the only one with a gripper)."""
-    monitor = next(a for a in paper.actions if isinstance(a, MonitorAction))
+    monitor = next(a for a in paper.actions if isinstance(a, MonitorJob))
     monitor = replace(
         monitor, k=2, duration_s=57.0, start_s=0.0, standoff_m=4.0, bearing_deg=bearing_deg
     )

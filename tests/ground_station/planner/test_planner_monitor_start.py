@@ -6,18 +6,18 @@ import msgspec
 import pytest
 
 from ground_station.planner import (
-    InspectAction,
-    MonitorAction,
+    Airframe,
+    InspectJob,
+    MonitorJob,
     Problem,
     Station,
     Uav,
-    UavType,
-    Waypoint,
+    Viewpoint,
     plan,
     validate,
 )
 
-SAFETY = UavType(
+SAFETY = Airframe(
     id="safety",
     capabilities={"monitor": 0.0},
     cruise_speed_mps=10.0,
@@ -25,7 +25,7 @@ SAFETY = UavType(
     flight_power_w=230.0,
     hover_power_w=210.0,
 )
-INSPECTION = UavType(
+INSPECTION = Airframe(
     id="inspection",
     capabilities={"inspect": 0.0, "monitor": 0.5},
     cruise_speed_mps=10.0,
@@ -47,14 +47,15 @@ def _problem() -> Problem:
             id="U2", type="inspection", position_m=(0.0, 0.0, 0.0), home_station="S", energy_wh=60.0
         ),
     )
-    inspect = InspectAction(
+    inspect = InspectJob(
         id="line",
         weight=2.0,
         waypoints=tuple(
-            Waypoint(position_m=(x, 20.0, 5.0), service_s=300.0) for x in (-40.0, -20.0, 20.0, 40.0)
+            Viewpoint(position_m=(x, 20.0, 5.0), service_s=300.0)
+            for x in (-40.0, -20.0, 20.0, 40.0)
         ),
     )
-    watch = MonitorAction(id="watch", worker_m=(100.0, 0.0, 0.0), duration_s=300.0)
+    watch = MonitorJob(id="watch", worker_m=(100.0, 0.0, 0.0), duration_s=300.0)
     return Problem(
         stations=(station,),
         uav_types=(SAFETY, INSPECTION),
@@ -87,7 +88,7 @@ def test_a_synchronised_start_leaves_the_take_off_time_to_a_uav_on_a_pad() -> No
         Uav(id=u, type="safety", position_m=(0.0, 0.0, 0.0), home_station="S", energy_wh=60.0)
         for u in ("U1", "U2")
     )
-    watch = MonitorAction(id="watch", worker_m=(100.0, 0.0, 0.0), k=2, duration_s=120.0)
+    watch = MonitorJob(id="watch", worker_m=(100.0, 0.0, 0.0), k=2, duration_s=120.0)
     base = Problem(stations=(station,), uav_types=(SAFETY,), uavs=uavs, actions=(watch,))
 
     def start(problem: Problem) -> float:

@@ -8,18 +8,18 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from ground_station.planner import (
-    DeliverAction,
-    InspectAction,
-    MonitorAction,
+    Airframe,
+    DeliverJob,
+    InspectJob,
+    MonitorJob,
     Options,
-    Plan,
     Problem,
     RunningTask,
+    Solution,
     Station,
-    ToolStation,
+    ToolDepot,
     Uav,
-    UavType,
-    Waypoint,
+    Viewpoint,
     plan,
     validate,
 )
@@ -43,14 +43,14 @@ def problems(draw: st.DrawFn) -> Problem:
         )
         for i in range(draw(st.integers(1, 3)))
     ]
-    tools = [ToolStation(id="T0", position_m=draw(point), tools=("wrench",))]
+    tools = [ToolDepot(id="T0", position_m=draw(point), tools=("wrench",))]
     caps = st.dictionaries(
         st.sampled_from(["inspect", "monitor", "deliver"]),
         st.sampled_from([0.0, 0.5, 1.0]),
         min_size=1,
     )
     types = [
-        UavType(
+        Airframe(
             id=f"type{i}",
             capabilities=draw(caps),
             cruise_speed_mps=draw(st.sampled_from([5.0, 12.0])),
@@ -84,13 +84,13 @@ def problems(draw: st.DrawFn) -> Problem:
         }
         if kind == "inspect":
             wps = [
-                Waypoint(position_m=draw(point), service_s=draw(st.sampled_from([0.0, 30.0])))
+                Viewpoint(position_m=draw(point), service_s=draw(st.sampled_from([0.0, 30.0])))
                 for _ in range(draw(st.integers(1, 5)))
             ]
-            actions.append(InspectAction(waypoints=tuple(wps), **common))
+            actions.append(InspectJob(waypoints=tuple(wps), **common))
         elif kind == "monitor":
             actions.append(
-                MonitorAction(
+                MonitorJob(
                     worker_m=draw(point),
                     k=draw(st.integers(1, 3)),
                     standoff_m=8.0,
@@ -100,7 +100,7 @@ def problems(draw: st.DrawFn) -> Problem:
             )
         else:
             actions.append(
-                DeliverAction(tool="wrench", tool_station="T0", worker_m=draw(point), **common)
+                DeliverJob(tool="wrench", tool_station="T0", worker_m=draw(point), **common)
             )
     return Problem(
         stations=tuple(stations),
@@ -112,7 +112,7 @@ def problems(draw: st.DrawFn) -> Problem:
     )
 
 
-def accounted(problem: Problem, p: Plan) -> None:
+def accounted(problem: Problem, p: Solution) -> None:
     planned = {s.action_id for u in p.uavs for s in u.steps if s.action_id}
     unplaced = {x.action_id for x in p.unplaced}
     for a in problem.actions:
@@ -153,7 +153,7 @@ def test_corridor_instances_validate(n_uavs, n_actions, seed, mode) -> None:
 @given(st.integers(0, 10_000), st.sampled_from([5.0, 60.0, 200.0]))
 def test_running_tasks_are_kept_or_redone_and_plans_validate(seed, remaining_s) -> None:
     problem = generate(6, 12, seed)
-    inspections = [a for a in problem.actions if isinstance(a, InspectAction)]
+    inspections = [a for a in problem.actions if isinstance(a, InspectJob)]
     if not inspections:
         return
     target = inspections[0]

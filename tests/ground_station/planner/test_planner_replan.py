@@ -9,11 +9,11 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from ground_station.planner import (
-    DeliverAction,
-    InspectAction,
+    DeliverJob,
+    InspectJob,
     PlanningProblemError,
     Problem,
-    Waypoint,
+    Viewpoint,
     validate,
 )
 from ground_station.planner.replan import (
@@ -30,10 +30,10 @@ from ground_station.planner.replan import (
 from linecrew.planner_tools.generator import generate
 
 replace = msgspec.structs.replace
-NEW = InspectAction(
+NEW = InspectJob(
     id="new",
     weight=5.0,
-    waypoints=(Waypoint(position_m=(5.0, 5.0, 3.0), service_s=5.0),),
+    waypoints=(Viewpoint(position_m=(5.0, 5.0, 3.0), service_s=5.0),),
 )
 
 
@@ -46,8 +46,8 @@ def check(s: Session):
 def test_action_added_is_planned_and_other_routes_untouched() -> None:
     s = Session(generate(10, 30, 3))
     before = {u: r.steps for u, r in s.ctx.routes.items()}
-    a = InspectAction(
-        id="extra", waypoints=(Waypoint(position_m=(600.0, 10.0, 30.0), service_s=20.0),)
+    a = InspectJob(
+        id="extra", waypoints=(Viewpoint(position_m=(600.0, 10.0, 30.0), service_s=20.0),)
     )
     p = s.apply(ActionAdded(action=a))
     assert validate(s.problem, p) == []
@@ -132,7 +132,7 @@ def test_random_event_sequences_keep_plans_valid(seed, kinds) -> None:
         uid = uids[(seed + n) % len(uids)]
         if kind == 0:
             a = extra[n % len(extra)]
-            if isinstance(a, DeliverAction):
+            if isinstance(a, DeliverJob):
                 a = replace(a, tool_station="T0")
             s.apply(ActionAdded(action=replace(a, id=f"x{n}")))
         elif kind == 1 and aids:

@@ -7,12 +7,12 @@ from itertools import pairwise
 import msgspec
 
 from ground_station.planner import (
-    DeliverAction,
-    InspectAction,
+    DeliverJob,
+    InspectJob,
     Problem,
     RunningTask,
     Station,
-    Waypoint,
+    Viewpoint,
     plan,
     validate,
 )
@@ -30,10 +30,10 @@ def test_one_pad_is_shared_in_turn(fig6: Problem) -> None:
     pad = Station(id="P", position_m=(0.0, 0.0, 0.0), pads=1, recharge="charge", full_charge_s=300)
     low = [replace(u, position_m=(0.0, 0.0, 0.0), energy_wh=15.0) for u in fig6.uavs]
     landing_only = tuple(replace(s, pads=0) for s in fig6.stations)
-    far = InspectAction(
+    far = InspectJob(
         id="far",
         waypoints=tuple(
-            Waypoint(position_m=(x, 30.0, 5.0), service_s=20.0) for x in (-20.0, 0.0, 20.0, 40.0)
+            Viewpoint(position_m=(x, 30.0, 5.0), service_s=20.0) for x in (-20.0, 0.0, 20.0, 40.0)
         ),
     )
     problem = replace(fig6, stations=(pad, *landing_only), uavs=tuple(low), actions=(far,))
@@ -51,10 +51,10 @@ def test_one_pad_is_shared_in_turn(fig6: Problem) -> None:
 
 
 def test_long_inspection_is_split_by_a_recharge(fig6: Problem) -> None:
-    line = InspectAction(
+    line = InspectJob(
         id="line",
         waypoints=tuple(
-            Waypoint(position_m=(x, 12.0, 3.0), service_s=40.0) for x in range(-8, 9, 2)
+            Viewpoint(position_m=(x, 12.0, 3.0), service_s=40.0) for x in range(-8, 9, 2)
         ),
     )
     one = (replace(fig6.uavs[1], energy_wh=100.0),)
@@ -127,7 +127,7 @@ def _holds_at(result, point, kind):
 def test_two_inspections_of_one_point_take_turns(fig6: Problem) -> None:
     point = (3.0, 12.0, 4.0)
     both = tuple(
-        InspectAction(id=f"look-{n}", waypoints=(Waypoint(position_m=point, service_s=60.0),))
+        InspectJob(id=f"look-{n}", waypoints=(Viewpoint(position_m=point, service_s=60.0),))
         for n in (1, 2)
     )
     problem = replace(fig6, actions=both)
@@ -140,7 +140,7 @@ def test_two_inspections_of_one_point_take_turns(fig6: Problem) -> None:
 def test_picks_at_one_tool_station_take_turns(fig6: Problem) -> None:
     physical = replace(fig6.uavs[0], id="uav3", position_m=(0.0, 20.0, 0.0), home_station="C2")
     deliveries = tuple(
-        DeliverAction(id=f"bring-{n}", tool="wrench", tool_station="tools", worker_m=w, pick_s=60.0)
+        DeliverJob(id=f"bring-{n}", tool="wrench", tool_station="tools", worker_m=w, pick_s=60.0)
         for n, w in ((1, (0.0, 10.0, 3.0)), (2, (8.0, 2.0, 3.0)))
     )
     problem = replace(fig6, uavs=(*fig6.uavs, physical), actions=deliveries)
@@ -168,12 +168,12 @@ def test_a_point_added_live_between_two_held_points_waits_for_both(fig6: Problem
     joins them into one hold: bookings made at either still count."""
     second = replace(fig6.uavs[1], id="uav3")  # two inspectors: a and b at once
     look = [
-        InspectAction(id=f"look-{n}", waypoints=(Waypoint(position_m=p, service_s=s),))
+        InspectJob(id=f"look-{n}", waypoints=(Viewpoint(position_m=p, service_s=s),))
         for n, p, s in (("a", (3.0, 12.0, 4.0), 30.0), ("b", (4.6, 12.0, 4.0), 90.0))
     ]
     session = Session(replace(fig6, uavs=(*fig6.uavs, second), actions=tuple(look)))
     between = (3.8, 12.0, 4.0)
-    added = InspectAction(id="look-c", waypoints=(Waypoint(position_m=between, service_s=30.0),))
+    added = InspectJob(id="look-c", waypoints=(Viewpoint(position_m=between, service_s=30.0),))
     result = session.apply(ActionAdded(action=added))
     assert validate(session.problem, result) == []
     held = {

@@ -6,9 +6,9 @@ import msgspec
 import pytest
 
 from ground_station.planner import (
-    DeliverAction,
-    Plan,
+    DeliverJob,
     Problem,
+    Solution,
     Step,
     Unplaced,
     plan,
@@ -19,17 +19,17 @@ replace = msgspec.structs.replace
 
 
 @pytest.fixture
-def base(fig6: Problem) -> tuple[Problem, Plan]:
+def base(fig6: Problem) -> tuple[Problem, Solution]:
     result = plan(fig6)
     assert validate(fig6, result) == []
     return fig6, result
 
 
-def codes(problem: Problem, p: Plan) -> set[str]:
+def codes(problem: Problem, p: Solution) -> set[str]:
     return {v.code for v in validate(problem, p)}
 
 
-def edit_step(p: Plan, uav: int, at: int, /, **changes: object) -> Plan:
+def edit_step(p: Solution, uav: int, at: int, /, **changes: object) -> Solution:
     steps = list(p.uavs[uav].steps)
     steps[at] = replace(steps[at], **changes)
     uavs = list(p.uavs)
@@ -37,13 +37,13 @@ def edit_step(p: Plan, uav: int, at: int, /, **changes: object) -> Plan:
     return replace(p, uavs=tuple(uavs))
 
 
-def set_steps(p: Plan, uav: int, steps: list[Step]) -> Plan:
+def set_steps(p: Solution, uav: int, steps: list[Step]) -> Solution:
     uavs = list(p.uavs)
     uavs[uav] = replace(uavs[uav], steps=tuple(steps))
     return replace(p, uavs=tuple(uavs))
 
 
-def find(p: Plan, uav: int, kind: str, nth: int = 0) -> int:
+def find(p: Solution, uav: int, kind: str, nth: int = 0) -> int:
     return [i for i, s in enumerate(p.uavs[uav].steps) if s.kind == kind][nth]
 
 
@@ -132,7 +132,7 @@ def test_pick_while_holding_a_tool(base) -> None:
 
 def test_deliver_missing(base) -> None:
     problem, p = base
-    extra = DeliverAction(
+    extra = DeliverJob(
         id="a5-deliver", tool="wrench", tool_station="tools", worker_m=(0.0, 10.0, 3.0)
     )
     assert "deliver_count" in codes(replace(problem, actions=(*problem.actions, extra)), p)

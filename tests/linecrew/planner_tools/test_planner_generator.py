@@ -7,7 +7,7 @@ from math import dist
 
 import pytest
 
-from ground_station.planner import DeliverAction, MonitorAction, plan, validate
+from ground_station.planner import DeliverJob, MonitorJob, plan, validate
 from linecrew.planner_tools.generator import FAMILIES, TYPES, generate, ring_bearing
 
 
@@ -40,7 +40,7 @@ def test_charge_family_has_slow_single_pad_charging_only() -> None:
 
 def test_monitor_family_watches_long_with_several_uavs() -> None:
     problem = generate(10, 30, 0, "monitors")
-    watches = [a for a in problem.actions if isinstance(a, MonitorAction)]
+    watches = [a for a in problem.actions if isinstance(a, MonitorJob)]
     assert len(watches) >= len(problem.actions) // 2
     assert all(2 <= a.k <= 3 and a.duration_s >= 1200 for a in watches)
 
@@ -50,7 +50,7 @@ def test_tools_family_has_one_gripper_for_many_deliveries() -> None:
     kinds = {t.id: t.capabilities for t in problem.uav_types}
     grippers = [u for u in problem.uavs if "deliver" in kinds[u.type]]
     assert len(grippers) == 1
-    assert sum(isinstance(a, DeliverAction) for a in problem.actions) >= len(problem.actions) // 2
+    assert sum(isinstance(a, DeliverJob) for a in problem.actions) >= len(problem.actions) // 2
 
 
 @pytest.mark.parametrize("family", sorted(FAMILIES))
@@ -64,7 +64,7 @@ def test_a_workers_next_monitor_is_turned_away_from_every_slot_of_the_others():
     k = 2 one 30 deg from the nearest slot; never to a bearing that is new
     only for slot 0 (the old rule gave 37 deg steps: 481 deg is 1 deg off 120)."""
     worker = (0.0, 0.0, 10.0)
-    three = MonitorAction(id="a", worker_m=worker, k=3, bearing_deg=0.0, duration_s=60.0)
+    three = MonitorJob(id="a", worker_m=worker, k=3, bearing_deg=0.0, duration_s=60.0)
     assert ring_bearing([three], worker) == 60.0
     assert ring_bearing([three], worker, 2) in (30.0, 90.0)
     assert ring_bearing([three], (5.0, 0.0, 10.0)) == 0.0  # another worker's slots do not count
@@ -77,7 +77,7 @@ def test_slots_of_one_worker_in_a_generated_instance_stay_apart(family, apart_de
     stream reported 77 ``separation`` violations at 20x200.)"""
     by_worker: dict = {}
     for a in generate(20, 200, 0, family=family).actions:
-        if isinstance(a, MonitorAction):
+        if isinstance(a, MonitorJob):
             slots = [(a.bearing_deg + 360.0 * s / a.k) % 360.0 for s in range(a.k)]
             by_worker.setdefault(a.worker_m, []).extend(slots)
     assert max(len(b) for b in by_worker.values()) >= 8

@@ -10,16 +10,16 @@ import msgspec
 import pytest
 
 from ground_station.planner import (
-    DeliverAction,
-    InspectAction,
-    MonitorAction,
+    Airframe,
+    DeliverJob,
+    InspectJob,
+    MonitorJob,
     Problem,
     RunningTask,
     Station,
-    ToolStation,
+    ToolDepot,
     Uav,
-    UavType,
-    Waypoint,
+    Viewpoint,
     plan,
     score,
     validate,
@@ -30,7 +30,7 @@ from linecrew.planner_tools.generator import generate
 pytest.importorskip("ortools")
 from linecrew.planner_tools.reference import solve
 
-DRONE = UavType(
+DRONE = Airframe(
     id="quad",
     capabilities={"inspect": 0.0, "monitor": 0.0},
     cruise_speed_mps=10.0,
@@ -60,10 +60,10 @@ def _problem(*actions, uavs=2) -> Problem:  # type: ignore[no-untyped-def]
 
 def test_two_waypoints_on_opposite_sides_go_to_two_uavs() -> None:
     wps = (
-        Waypoint(position_m=(300.0, 0.0, 20.0), service_s=30.0),
-        Waypoint(position_m=(-300.0, 0.0, 20.0), service_s=30.0),
+        Viewpoint(position_m=(300.0, 0.0, 20.0), service_s=30.0),
+        Viewpoint(position_m=(-300.0, 0.0, 20.0), service_s=30.0),
     )
-    problem = _problem(InspectAction(id="I", waypoints=wps))
+    problem = _problem(InspectJob(id="I", waypoints=wps))
     ref = solve(problem, time_limit_s=30.0)
     assert ref.status == "OPTIMAL" and ref.plan is not None
     assert validate(problem, ref.plan) == []
@@ -76,7 +76,7 @@ def test_two_waypoints_on_opposite_sides_go_to_two_uavs() -> None:
 
 def test_a_watch_longer_than_a_battery_is_handed_over() -> None:
     # 40 Wh usable at 200 W hover is 720 s: a 1000 s watch needs two UAVs.
-    watch = MonitorAction(id="M", worker_m=(100.0, 0.0, 20.0), standoff_m=10.0, duration_s=1000.0)
+    watch = MonitorJob(id="M", worker_m=(100.0, 0.0, 20.0), standoff_m=10.0, duration_s=1000.0)
     problem = _problem(watch)
     ref = solve(problem, time_limit_s=30.0)
     assert ref.plan is not None and validate(problem, ref.plan) == []
@@ -85,8 +85,8 @@ def test_a_watch_longer_than_a_battery_is_handed_over() -> None:
 
 
 def test_the_hint_is_used_and_a_bad_problem_is_refused() -> None:
-    wps = tuple(Waypoint(position_m=(100.0 * i, 50.0, 20.0), service_s=10.0) for i in range(4))
-    problem = _problem(InspectAction(id="I", waypoints=wps))
+    wps = tuple(Viewpoint(position_m=(100.0 * i, 50.0, 20.0), service_s=10.0) for i in range(4))
+    problem = _problem(InspectJob(id="I", waypoints=wps))
     ours = plan(problem, max_rounds=50)
     ref = solve(problem, time_limit_s=10.0, hint=ours)
     assert ref.plan is not None and validate(problem, ref.plan) == []
@@ -101,10 +101,10 @@ def test_the_hint_is_used_and_a_bad_problem_is_refused() -> None:
 def test_waypoints_are_flown_in_the_best_order_not_the_index_order() -> None:
     # Index order 0, 1, 2 zig-zags (486 m); 0, 2, 1 flies the square (404 m).
     wps = tuple(
-        Waypoint(position_m=p, service_s=5.0)
+        Viewpoint(position_m=p, service_s=5.0)
         for p in ((100.0, 0.0, 20.0), (0.0, 100.0, 20.0), (100.0, 100.0, 20.0))
     )
-    problem = _problem(InspectAction(id="I", waypoints=wps), uavs=1)
+    problem = _problem(InspectJob(id="I", waypoints=wps), uavs=1)
     ref = solve(problem, time_limit_s=30.0)
     assert ref.status == "OPTIMAL" and ref.plan is not None
     assert validate(problem, ref.plan) == []
@@ -116,7 +116,7 @@ def test_waypoints_are_flown_in_the_best_order_not_the_index_order() -> None:
 def test_a_tool_is_carried_past_other_work() -> None:
     # home (0,0), tools (0,300), worker (300,300), waypoint half-way between:
     # pick, inspect on the way, then drop beats pick-drop as one block.
-    courier = UavType(
+    courier = Airframe(
         id="courier",
         capabilities={"inspect": 0.0, "deliver": 0.0},
         cruise_speed_mps=10.0,
@@ -125,8 +125,8 @@ def test_a_tool_is_carried_past_other_work() -> None:
         hover_power_w=200.0,
     )
     base = _problem(
-        InspectAction(id="I", waypoints=(Waypoint(position_m=(150.0, 300.0, 5.0), service_s=5.0),)),
-        DeliverAction(
+        InspectJob(id="I", waypoints=(Viewpoint(position_m=(150.0, 300.0, 5.0), service_s=5.0),)),
+        DeliverJob(
             id="D",
             tool="wrench",
             tool_station="T",
@@ -140,7 +140,7 @@ def test_a_tool_is_carried_past_other_work() -> None:
         base,
         uav_types=(courier,),
         uavs=(msgspec.structs.replace(base.uavs[0], type="courier"),),
-        tool_stations=(ToolStation(id="T", position_m=(0.0, 300.0, 5.0), tools=("wrench",)),),
+        tool_stations=(ToolDepot(id="T", position_m=(0.0, 300.0, 5.0), tools=("wrench",)),),
     )
     ref = solve(problem, time_limit_s=30.0)
     assert ref.status == "OPTIMAL" and ref.plan is not None
