@@ -33,10 +33,6 @@ the target it was flying to: it holds that point too (a hung agent's
 autopilot flies on to its last target)."""
 HOVER_M = 1.0
 """A UAV heard this close to its target hovers there (or is about to)."""
-REUSE_S = 0.05
-"""The sightings of a report are worked out again once this much (real)
-time has passed: one tick asks for them several times, and 25 agents of one
-host each tick a 100-entry report."""
 
 
 class Sighting(NamedTuple):
@@ -56,12 +52,10 @@ class Traffic:
         self.uav_id = uav_id
         self._report: TrafficReport | None = None
         self._received_s = 0.0
-        self._sightings: tuple[float, list[Sighting]] | None = None  # (at, sightings)
 
     def update(self, report: TrafficReport, now_s: float) -> None:
         """Keep ``report`` (received at ``now_s`` of the link clock)."""
         self._report, self._received_s = report, now_s
-        self._sightings = None
 
     def position(self, uav_id: str, now_s: float) -> Point | None:
         """Where ``uav_id`` was last heard airborne, if the report says so."""
@@ -214,10 +208,7 @@ class Traffic:
 
     def _others(self, now_s: float) -> list[Sighting]:
         """Where the other airborne UAVs of the report may be: where each
-        was heard, and the target each was flying to (as of at most
-        ``REUSE_S`` ago)."""
-        if self._sightings is not None and 0.0 <= now_s - self._sightings[0] < REUSE_S:
-            return self._sightings[1]
+        was heard, and the target each was flying to."""
         if self._report is None:
             return []
         since = now_s - self._received_s
@@ -231,7 +222,6 @@ class Traffic:
             out.append(Sighting(e.uav_id, e.position, unheard, target=False, hovering=hovering))
             if e.target is not None:
                 out.append(Sighting(e.uav_id, e.target, unheard, target=True))
-        self._sightings = (now_s, out)
         return out
 
 

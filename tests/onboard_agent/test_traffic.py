@@ -8,7 +8,7 @@ import pytest
 
 from onboard_agent.route import SIDESTEP_M, next_leg
 from onboard_agent.surroundings import horizontal_distance
-from onboard_agent.traffic import REUSE_S, UNHEARD_S, Traffic
+from onboard_agent.traffic import Traffic
 from proto.geo import Point
 from proto.telemetry import Traffic as TrafficReport
 from proto.telemetry import TrafficEntry
@@ -270,18 +270,3 @@ def test_of_two_uavs_climbing_and_descending_past_each_other_only_the_later_move
     assert beside.z_m == one_at.z_m and horizontal_distance(beside, two_at) >= SIDESTEP_M
     far = msgspec.structs.replace(two, position=p(6.0, 21.0, 12.4), target=p(6.0, 21.0, 3.0))
     assert leg(seen_by("uav-1", far), one_at, one_to) == one_to  # none in the way: climbs
-
-
-def test_sightings_are_reused_within_a_tick_yet_age_and_follow_each_report():
-    """One tick asks for the sightings several times; they are worked out
-    once per ``REUSE_S``, and still age (unheard after ``UNHEARD_S``) and
-    change with every report."""
-    traffic = report(entry(p(0, 0, 6), target=p(5, 0, 6)))
-    first = traffic.holder(p(0, 0, 6), 1.0, 0.0)
-    assert first is not None and not first.unheard
-    assert traffic.holder(p(0, 0, 6), 1.0, REUSE_S / 2) == first
-    later = traffic.holder(p(5, 0, 6), 1.0, UNHEARD_S + 0.5)  # unheard: holds its target
-    assert later is not None and later.unheard and later.where == p(5, 0, 6)
-    traffic.update(TrafficReport(uavs=[entry(p(9, 9, 6))]), UNHEARD_S + 0.5 + REUSE_S / 4)
-    moved = traffic.holder(p(9, 9, 6), 1.0, UNHEARD_S + 0.5 + REUSE_S / 2)
-    assert moved is not None and moved.where == p(9, 9, 6)
