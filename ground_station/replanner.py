@@ -333,8 +333,7 @@ class Replanner:
     def improve(
         self, job: ReplanJob, should_stop: Callable[[], bool] = lambda: False
     ) -> Computed | None:
-        """Try to improve the live plan (pure: on the worker's thread). The
-        result is committed only through ``adopt``."""
+        """Try to improve the live plan (pure: worker thread; ``adopt`` commits)."""
         s = self.improve_settings
         started = time.perf_counter()
         frozen = frozen_parts(job.frozen or {})
