@@ -17,6 +17,7 @@ class GsConfig(EnvSettings):
     scenario: str = "paper"  # shipped scenario name or a scenario file
     db_path: str = "linecrew-gs.db"  # the SQLite store (created if missing)
     gs_id: str = "gs"  # name of this ground station's liveliness token
+    store_wait_s: float = 60.0  # wall s to retry a store that cannot write at start
     link_timeout_s: float = 5.0  # silence before a UAV is lost; > the agents' 3 s
     watchdog_period_s: float = 0.1  # how often the watchdog looks
     battery_margin_fraction: float = 0.1  # battery below the plan by this much -> replan

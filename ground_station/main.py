@@ -5,6 +5,8 @@ from __future__ import annotations
 import asyncio
 import logging
 import sys
+import time
+from collections.abc import Callable
 
 from ground_station.config import GsConfig
 from ground_station.service import GroundStation
@@ -16,6 +18,9 @@ from linecrew_runtime.scenarios import ScenarioError, load
 from proto.errors import Unavailable
 
 log = logging.getLogger("linecrew.ground_station")
+
+STORE_RETRY_S = 1.0
+"""Wall seconds between two attempts to open a store that cannot write."""
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -46,16 +51,35 @@ def main(argv: list[str] | None = None) -> int:
         log.error("ground station cannot start: %s", exc)
         return 1
     with bus:
-        try:
-            station = GroundStation(
+        station = _when_store_writes(
+            lambda: GroundStation(
                 config, scenario, bus, clock=mission_clock(args.speedup), speedup=args.speedup
-            )
-        except StoreUnavailable as exc:
-            log.error("ground station cannot start: %s", exc)
+            ),
+            config.store_wait_s,
+            shutdown,
+        )
+        if station is None:
             return 1
         asyncio.run(station.run(shutdown))
     log.info("ground station stopped on %s", shutdown.signal_name or "request")
     return 0
+
+
+def _when_store_writes(
+    build: Callable[[], GroundStation], wait_s: float, shutdown: Shutdown
+) -> GroundStation | None:
+    """``build()``, retried once a second while the store cannot write (a
+    disk read-only or full for a while, a volume not yet mounted) for up to
+    ``wait_s``; None, said in the log, if it never could or on shutdown."""
+    deadline = time.monotonic() + wait_s
+    while True:
+        try:
+            return build()
+        except StoreUnavailable as exc:
+            if time.monotonic() >= deadline or shutdown.wait(STORE_RETRY_S):
+                log.error("ground station cannot start: %s", exc)
+                return None
+            log.warning("the store cannot write yet; retrying", extra={"error": str(exc)})
 
 
 if __name__ == "__main__":

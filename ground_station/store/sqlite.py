@@ -36,12 +36,16 @@ class Store:
         self.failing: str | None = None
         try:
             self._conn = sqlite3.connect(path, isolation_level=None)
+        except sqlite3.Error as exc:
+            raise StoreUnavailable(f"the store {path} cannot be used: {exc}") from exc
+        try:
             self._conn.execute("PRAGMA journal_mode=WAL")
             self._conn.execute("PRAGMA synchronous=FULL")
             self._conn.execute("PRAGMA foreign_keys=ON")
             self.schema_version = migrate(self._conn)
             self.next_counter("starts")  # proves the file takes writes now
-        except sqlite3.Error as exc:
+        except (sqlite3.Error, StoreUnavailable) as exc:
+            self._conn.close()  # a caller may try again: no handle left open
             raise StoreUnavailable(f"the store {path} cannot be used: {exc}") from exc
 
     def close(self) -> None:

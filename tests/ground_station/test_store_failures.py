@@ -5,7 +5,9 @@ and a clear error, not a traceback, when the store is unusable at start."""
 
 from __future__ import annotations
 
+import os
 import subprocess
+import time
 
 import pytest
 
@@ -28,7 +30,7 @@ from tests.ground_station.test_service import (
 )
 from tests.ground_station.test_store import record
 from tests.support.disk import small_disk
-from tests.support.processes import running, wait_until
+from tests.support.processes import running, start, wait_until
 
 
 @pytest.fixture
@@ -79,11 +81,37 @@ def test_an_unusable_store_at_start_is_a_clear_error(disk, router, how):
         disk.fill()
     with pytest.raises(StoreUnavailable, match="cannot be used"):
         Store(str(path))
-    done = subprocess.run(gs_args(router, str(path)), capture_output=True, text=True, timeout=60)
+    env = {**os.environ, "LINECREW_GS_STORE_WAIT_S": "2"}
+    begun = time.monotonic()
+    done = subprocess.run(
+        gs_args(router, str(path)), capture_output=True, text=True, timeout=60, env=env
+    )
     assert done.returncode == 1
+    assert time.monotonic() - begun >= 2.0  # it tried again before giving up
+    assert done.stderr.count("cannot write yet") >= 1, done.stderr
     assert "cannot start" in done.stderr and "Traceback" not in done.stderr, done.stderr
     if how == "read-only":
         disk.read_only(False)
+
+
+def test_a_ground_station_started_on_a_read_only_store_starts_once_it_writes(
+    disk, router, bus_config
+):
+    path = disk.root / "gs.db"
+    Store(str(path)).close()
+    disk.read_only()
+    gs = start(gs_args(router, str(path)), "gs")
+    try:
+        wait_until(lambda: "cannot write yet" in gs.output(), 20, "the gs waiting for its store")
+        assert gs.alive()
+        disk.read_only(False)
+        with Bus.open(bus_config) as client:
+            wait_until(lambda: gs_alive(client), 20, "the gs up once the store writes")
+            assert submit(client, "inspect-loop").record.state == ActionState.ACCEPTED
+        assert "cannot start" not in gs.output()
+    finally:
+        disk.read_only(False)
+        gs.stop()
 
 
 def metric(client: Bus, name: str) -> float | None:
