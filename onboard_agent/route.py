@@ -70,7 +70,7 @@ def next_leg(
     layer: tuple[int, int] | None = None,
     traffic: Iterable[Point] = (),
     ahead: Iterable[Point] = (),
-    climbers: Iterable[Point] = (),
+    verticals: Iterable[Point] = (),
     movers: Iterable[Point] = (),
 ) -> Point:
     """The point to send the autopilot now on the way from ``here`` to
@@ -90,10 +90,11 @@ def next_leg(
     person on the way when the track passes over it (nearer than
     ``SIDESTEP_M``; chaos seed 20: a UAV flying to its spot passed level
     over one hovering above the next). Where one on its way is now (a UAV
-    leaving the slot its relief flies to) is not. ``climbers`` are where
-    UAVs climbing straight up are (those whose climb targets this UAV does
-    not cross over): a leg across one's column within its height band waits,
-    holding where the UAV is, until it has climbed clear (:func:`_across`).
+    leaving the slot its relief flies to) is not. ``verticals`` are where
+    UAVs climbing or descending straight are (those whose climb targets this
+    UAV does not cross over): a leg across one's column within its height
+    band waits, holding where the UAV is, until it has passed clear
+    (:func:`_across`).
     ``movers`` are where UAVs after this one in id order are heard on their
     way: a climb or descent that would pass one holds where the UAV is
     (:func:`_vertical`); that UAV sees this one in its way and moves clear
@@ -101,7 +102,7 @@ def next_leg(
     each other at once chose one point and met 0.97 m apart)."""
     if math.hypot(target.x_m - here.x_m, target.y_m - here.y_m) <= TOLERANCE_M:
         leg = _vertical(here, target, target, traffic, movers)  # straight up or down
-        return _across(here, leg, climbers, clear_m)
+        return _across(here, leg, verticals, clear_m)
     low = min(here.z_m, target.z_m)
 
     def near(points: Iterable[Point]) -> list[Point]:
@@ -116,7 +117,7 @@ def next_leg(
 
     near_people, near_columns = near(people), near(columns)
     if not near_people and not near_columns and cruise_z is None:
-        return _across(here, target, climbers, clear_m)
+        return _across(here, target, verticals, clear_m)
     passed_over = [p for p in ahead if ground_distance(p, here, target) < SIDESTEP_M - TOLERANCE_M]
     beside_target = [
         p
@@ -135,17 +136,17 @@ def next_leg(
     if here.z_m < crossing - TOLERANCE_M:
         up = Point(x_m=here.x_m, y_m=here.y_m, z_m=crossing)
         return _vertical(here, up, target, traffic, movers)
-    return _across(here, Point(x_m=target.x_m, y_m=target.y_m, z_m=crossing), climbers, clear_m)
+    return _across(here, Point(x_m=target.x_m, y_m=target.y_m, z_m=crossing), verticals, clear_m)
 
 
-def _across(here: Point, leg: Point, climbers: Iterable[Point], clear_m: float) -> Point:
+def _across(here: Point, leg: Point, verticals: Iterable[Point], clear_m: float) -> Point:
     """``leg``, or where the UAV is while the leg would pass within
-    ``clear_m`` of a climber's column (horizontally) with the climber within
-    ``clear_m`` of the leg's height band: chaos seed 14, a UAV re-routed
+    ``clear_m`` of the column of one of ``verticals`` (horizontally) with it
+    within ``clear_m`` of the leg's height band: chaos seed 14, a UAV re-routed
     mid-climb flew level across the column of one climbing beside it out
     of the next spot (0.88 m)."""
     low, high = min(here.z_m, leg.z_m) - clear_m, max(here.z_m, leg.z_m) + clear_m
-    for c in climbers:
+    for c in verticals:
         if ground_distance(c, here, leg) < clear_m and low < c.z_m < high:
             return here
     return leg

@@ -160,10 +160,14 @@ class Traffic:
             if all(p.distance_to(where) >= HOVER_M for where in heard.values())
         ]
 
-    def climbers(self, now_s: float) -> list[Point]:
-        """Where the UAVs after this one in id order that climb straight up
-        are (their climb targets are not obstacles for this UAV: it waits
-        for them to climb clear instead, :func:`onboard_agent.route.next_leg`)."""
+    def verticals(self, now_s: float) -> list[Point]:
+        """Where the UAVs after this one in id order that climb or descend
+        straight are: this UAV waits for them to pass clear of its level legs
+        (:func:`onboard_agent.route.next_leg`; their climb targets are no
+        obstacles for it, and where one descending is now is none either:
+        chaos seed 13, an earlier UAV turned level across the column of a
+        later one that had just begun to descend in it and passed 1.00 m
+        from it)."""
         others = self._others(now_s)
         heard = {s.uav_id: s.where for s in others if not s.target and not s.unheard}
         return [
@@ -172,7 +176,7 @@ class Traffic:
             if s.target
             and s.uav_id > self.uav_id
             and s.uav_id in heard
-            and s.where.z_m > heard[s.uav_id].z_m + HOVER_M
+            and abs(s.where.z_m - heard[s.uav_id].z_m) > HOVER_M
             and horizontal_distance(s.where, heard[s.uav_id]) < HOVER_M
         ]
 

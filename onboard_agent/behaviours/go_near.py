@@ -175,7 +175,7 @@ class GoNear(AgentBehaviour):
         cruise_z = self.target.cruise_z(ctx)
         layer = ctx.spots.layer
         ahead = ctx.traffic.ahead(ctx.link_clock(), track)
-        climbers = ctx.traffic.climbers(ctx.link_clock())
+        verticals = ctx.traffic.verticals(ctx.link_clock())
         movers = ctx.traffic.movers(ctx.link_clock())
         leg = route.next_leg(
             vehicle.position,
@@ -187,7 +187,7 @@ class GoNear(AgentBehaviour):
             layer,
             traffic,
             ahead,
-            climbers,
+            verticals,
             movers,
         )
         moved = self._sent is None or self._sent.distance_to(leg) > config.follow_threshold_m

@@ -220,7 +220,9 @@ def test_a_uav_waits_to_cross_the_column_of_a_later_one_climbing_through_its_hei
 
     def leg(traffic: Traffic) -> Point:
         obstacles = traffic.obstacles(0.0, (here, target))
-        return next_leg(here, target, obstacles, 2.5, layer=(0, 3), climbers=traffic.climbers(0.0))
+        return next_leg(
+            here, target, obstacles, 2.5, layer=(0, 3), verticals=traffic.verticals(0.0)
+        )
 
     low = seen_by_uav1(11.3)
     assert next_leg(here, target, low.obstacles(0.0, (here, target)), 2.5, layer=(0, 3)) == target
@@ -229,8 +231,43 @@ def test_a_uav_waits_to_cross_the_column_of_a_later_one_climbing_through_its_hei
     uav1_climbing = TrafficEntry(uav_id="uav-1", position=here, airborne=True, target=p(-1, 20, 17))
     later = Traffic("uav-3")
     later.update(TrafficReport(uavs=[uav1_climbing]), 0.0)
-    assert later.climbers(0.0) == []  # never waits for one before it (it crosses over its climb)
+    assert later.verticals(0.0) == []  # never waits for one before it (it crosses over its climb)
     assert p(-1, 20, 17) in later.obstacles(0.0)
+
+
+def test_a_uav_waits_to_cross_the_column_of_a_later_one_descending_through_its_height():
+    """Chaos seed 13: uav-1 at W1's drop point, climbing to cross over uav-2
+    hovering at (0, 7, 6.5), turned level at 5.8 m across uav-2's column the
+    moment uav-2 began to descend in it (to 3 m, just outside the height
+    band) and passed 1.00 m from it. uav-1 holds until uav-2 is below."""
+    here, target = p(1.0, 5.0, 5.8), p(0.0, 10.0, 5.5)
+
+    def seen_by_uav1(z: float, hovering: bool = False) -> Traffic:
+        at = p(0.0, 7.0, z)
+        descent = TrafficEntry(
+            uav_id="uav-2", position=at, airborne=True, target=at if hovering else p(0, 7, 3)
+        )
+        traffic = Traffic("uav-1")
+        traffic.update(TrafficReport(uavs=[descent]), 0.0)
+        return traffic
+
+    def leg(traffic: Traffic) -> Point:
+        obstacles = traffic.obstacles(0.0, (here, target))
+        return next_leg(
+            here, target, obstacles, 2.5, layer=(0, 3), verticals=traffic.verticals(0.0)
+        )
+
+    assert leg(seen_by_uav1(6.3)) == here  # holds while uav-2 comes down through its height
+    assert leg(seen_by_uav1(4.5)) == here
+    assert leg(seen_by_uav1(3.0, hovering=True)) == target  # arrived below: goes
+    uav2 = Traffic("uav-2")
+    uav2.update(
+        TrafficReport(
+            uavs=[TrafficEntry(uav_id="uav-1", position=here, airborne=True, target=p(1, 5, 4))]
+        ),
+        0.0,
+    )
+    assert uav2.verticals(0.0) == []  # a later UAV never waits for an earlier one's descent
 
 
 def test_of_two_uavs_climbing_and_descending_past_each_other_only_the_later_moves_aside():
