@@ -37,7 +37,7 @@ def uavs_now(
     for spec in fleet.uavs:
         telemetry = monitor.telemetry(spec.id)
         capacity = capacity_wh(fleet, spec.id)
-        docked = docks.under(telemetry)
+        docked = docks.under(telemetry, spec.home_station)
         where = telemetry.position if telemetry else home_station(site, spec).position
         uavs.append(
             UavNow(
@@ -105,7 +105,7 @@ def drop_done_home(
     telemetry = monitor.telemetry(uav_id)
     if len(tasks) != 1 or not isinstance(tasks[0], GoHomeTask) or telemetry is None:
         return tasks
-    station = docks.under(telemetry)
+    station = docks.under(telemetry, tasks[0].station_id)
     return [] if station is not None and station.id == tasks[0].station_id else tasks
 
 
@@ -117,12 +117,16 @@ class Docks:
     def __init__(self, scenario: Scenario) -> None:
         self._spots = [(s, spot_positions(s, scenario.fleet)) for s in scenario.site.stations]
 
-    def under(self, telemetry: Telemetry | None) -> ChargingStation | None:
-        """The station a landed UAV sits on a spot of, if any."""
+    def under(self, telemetry: Telemetry | None, first: str = "") -> ChargingStation | None:
+        """The station a landed UAV sits on a spot of, if any; station
+        ``first`` before the others (where the rows of spots of two
+        stations cross, as on a site resized to 100 UAVs, a UAV on its home
+        spot is at home, not at the other station: it was sent home again
+        and again)."""
         if telemetry is None or telemetry.flight_state != FlightState.LANDED:
             return None
         p = telemetry.position
-        for station, spots in self._spots:
+        for station, spots in sorted(self._spots, key=lambda entry: entry[0].id != first):
             if any(math.hypot(p.x_m - q.x_m, p.y_m - q.y_m) <= ON_PAD_M for q in spots):
                 return station
         return None

@@ -7,11 +7,15 @@ Pure planning, no I/O, no clock: it runs on the planning worker's thread
 on a request's path.
 
 - **Incremental.** A session is built at a base mission time ``base_s``. A
-  replan within ``window_s`` of it, with no UAV moved, diffs the new problem
-  (built on the same time base) against the session's and applies the
-  differences as planner events: an action added, changed or cancelled, a
-  UAV lost, a battery below what the session assumed. Anything else (time
-  moved on, a UAV flew, came back or charged, a task finished, an event the
+  replan within ``window_s`` of it diffs the new problem (built on the same
+  time base) against the session's and applies the differences as planner
+  events: an action added, changed or cancelled, a UAV lost, a battery below
+  what the session assumed. A UAV on its course (flying the session's plan:
+  taken off, moved, its battery no lower than the plan has it by the end of
+  the step in progress) is no difference: at 100 UAVs, rebuilding for every
+  UAV that had moved rebuilt at every new action and re-dealt the work of
+  a quarter of the fleet each time. Anything else (time moved on, a UAV
+  moved off its plan, came back or charged, a task finished, an event the
   session refuses) rebuilds the session from the current state: the full
   rebuild is the fallback, with the same planner.
 - **Improvement.** ``improve`` runs the planner's ruin-and-recreate local
@@ -27,8 +31,8 @@ on a request's path.
 from __future__ import annotations
 
 import dataclasses
+import math
 from collections.abc import Callable
-from math import dist
 
 from ground_station import planner as pl
 from ground_station.planner import improve as improvement
@@ -53,6 +57,7 @@ class Planned:
     incremental: bool  # events applied to the kept session (else rebuilt)
     events: int  # planner events applied (0 when rebuilt)
     objective: Objective
+    rebuilt_for: str = ""  # why the session was rebuilt (when it was)
 
 
 @dataclasses.dataclass
@@ -76,22 +81,27 @@ class LivePlan:
         self.options = options
         self.window_s = window_s
         self.session: pl.Session | None = None
+        self.course: pl.Solution | None = None  # the session's plan, as last adopted
         self.base_s = 0.0
-        self.stale = True  # the session no longer matches the plans held: rebuild
+        self.stale = ""  # why the session no longer matches the plans held: rebuild
         self.rebuilds = 0
         self.incremental = 0
         self._kept: tuple[pl.Session, tuple] | None = None  # a candidate below the margin
         self._kept_objective: Objective = (0, 0.0)
         self._starts = 0  # constructions from scratch tried for this state
 
-    def reusable(self, now_s: float) -> bool:
-        """Whether a replan at ``now_s`` may use the session (its time base)."""
-        fresh = 0 <= now_s - self.base_s <= self.window_s
-        return self.session is not None and not self.stale and fresh
+    def unusable(self, now_s: float) -> str:
+        """Why a replan at ``now_s`` may not use the session ("" if it may)."""
+        if self.session is None:
+            return "no session yet"
+        if not 0 <= now_s - self.base_s <= self.window_s:
+            return f"{now_s - self.base_s:.0f} s past the session's start"
+        return self.stale
 
-    def invalidate(self) -> None:
-        """The next replan rebuilds (a task finished, a result was dropped)."""
-        self.stale = True
+    def invalidate(self, why: str) -> None:
+        """The next replan rebuilds, for ``why`` (a task finished, a result
+        was dropped)."""
+        self.stale = why
         self._new_state()
 
     def objective(self) -> Objective | None:
@@ -107,27 +117,28 @@ class LivePlan:
         session if it can, else a fresh session at ``now_s``. Raises
         ``PlanningProblemError`` if the problem itself is invalid."""
         self._new_state()  # candidates of the old state are moot
-        if self.reusable(now_s):
-            assert self.session is not None
+        why = self.unusable(now_s)
+        if not why:
+            assert self.session is not None and self.course is not None
             problem = build(self.base_s)
             try:
-                events = diff(self.session.problem, problem, capacities)
-            except _Rebuild:
-                events = None
-            if events is not None:
-                try:
-                    for event in events:
-                        self.session.apply(event)
-                    self.incremental += 1
-                    plan = self.session.plan()
-                    return Planned(plan, self.base_s, True, len(events), self._objective())
-                except pl.PlanningProblemError:
-                    pass  # the session refuses the change: rebuild from the state
+                floors = planned_floor(self.course, now_s - self.base_s)
+                events = diff(self.session.problem, problem, capacities, floors)
+                for event in events:
+                    self.session.apply(event)
+                self.incremental += 1
+                plan = self.course = self.session.plan()
+                return Planned(plan, self.base_s, True, len(events), self._objective())
+            except _Rebuild as exc:
+                why = str(exc)
+            except pl.PlanningProblemError as exc:  # rebuild from the state
+                why = f"the session refused the change: {exc}"
         problem = build(now_s)
         session = pl.Session(problem, self.options)
-        self.session, self.base_s, self.stale = session, now_s, False
+        self.session, self.base_s, self.stale = session, now_s, ""
         self.rebuilds += 1
-        return Planned(session.plan(), now_s, False, 0, self._objective())
+        self.course = session.plan()
+        return Planned(self.course, now_s, False, 0, self._objective(), why)
 
     def _objective(self) -> Objective:
         assert self.session is not None
@@ -205,7 +216,7 @@ class LivePlan:
 
     def take(self, candidate: Candidate) -> None:
         """Adopt ``candidate``: its session is the live one from now on."""
-        self.session = candidate.session
+        self.session, self.course = candidate.session, candidate.plan
         self._new_state()
 
     def keep(self, candidate: Candidate) -> None:
@@ -228,36 +239,58 @@ class _Rebuild(Exception):
     """The difference is not one the session can apply."""
 
 
-def diff(old: pl.Problem, new: pl.Problem, capacities: dict[str, float]) -> list[pl.Event]:
+def planned_floor(plan: pl.Solution, at_s: float) -> dict[str, float]:
+    """For each UAV whose plan has begun by ``at_s`` (planner time), the
+    lowest battery (Wh) the plan has it at by the end of its step in
+    progress: a UAV that has flown its plan so far is at or above it."""
+    out = {}
+    for uav in plan.uavs:
+        begun = [s.energy_after_wh for s in uav.steps if s.start_s <= at_s]
+        if begun:
+            out[uav.uav_id] = min(begun)
+    return out
+
+
+def diff(
+    old: pl.Problem,
+    new: pl.Problem,
+    capacities: dict[str, float],
+    floors: dict[str, float] | None = None,
+) -> list[pl.Event]:
     """The planner events that turn ``old`` into ``new`` (same time base);
-    raises ``_Rebuild`` when a difference is not such an event (a UAV moved,
-    took off, picked a tool, charged or came back)."""
+    raises ``_Rebuild`` when a difference is not such an event (a UAV moved
+    off its course, landed, picked a tool, charged or came back). ``floors``
+    (:func:`planned_floor`) names the UAVs on their course: one of them may
+    have moved and taken off, and used energy down to its floor, as planned."""
+    floors = floors or {}
     events: list[pl.Event] = []
     before = {u.id: u for u in old.uavs}
     if set(before) != {u.id for u in new.uavs} or old.stations != new.stations:
-        raise _Rebuild
+        raise _Rebuild("the fleet or the stations changed")
     fleet: list[pl.Event] = []
     for u in new.uavs:
         o = before[u.id]
         if u.available and not o.available:
-            raise _Rebuild  # a UAV back takes its share of the work, as in a full plan
+            raise _Rebuild(f"{u.id} back")  # it takes its share of the work, as in a full plan
         if u.available != o.available:
             fleet.append(pl.UavLost(uav_id=u.id))
             continue
         if not u.available:
             continue
-        if (
-            dist(u.position_m, o.position_m) > MOVED_M
-            or u.airborne != o.airborne
-            or u.tool != o.tool
-            or u.running != o.running
-        ):
-            raise _Rebuild
         tolerance = ENERGY_TOLERANCE * capacities.get(u.id, 1.0)
+        if u.tool != o.tool or u.running != o.running:
+            raise _Rebuild(f"{u.id} took or left a tool or a monitor slot")
+        floor = floors.get(u.id, math.inf)
+        if floor - tolerance <= u.energy_wh <= o.energy_wh + tolerance:
+            if o.airborne and not u.airborne:
+                raise _Rebuild(f"{u.id} landed")  # it charges or ended its flight
+            continue  # on its course: the session's start for it still holds
+        if math.dist(u.position_m, o.position_m) > MOVED_M or u.airborne != o.airborne:
+            raise _Rebuild(f"{u.id} moved off its plan")
         if o.energy_wh - u.energy_wh > tolerance:
             fleet.append(pl.BatteryLow(uav_id=u.id, energy_wh=u.energy_wh))
         elif u.energy_wh - o.energy_wh > tolerance:
-            raise _Rebuild  # charged: the session's recharges are wrong now
+            raise _Rebuild(f"{u.id} charged")  # the session's recharges are wrong now
     old_actions = {a.id: a for a in old.actions}
     new_ids = {a.id for a in new.actions}
     events += [pl.ActionCancelled(action_id=a) for a in old_actions if a not in new_ids]

@@ -67,7 +67,15 @@ class Computed:
     error: str = ""
     elapsed_s: float = 0.0
     incremental: bool = False
+    rebuilt_for: str = ""  # why the session was rebuilt (when it was)
     candidate: Candidate | None = None  # an improvement (then ``job.reason`` says so)
+
+    @property
+    def how(self) -> str:
+        """How the plan was made: improved, incremental, or rebuilt (and why)."""
+        if self.candidate is not None:
+            return "improved"
+        return "incremental" if self.incremental else f"rebuilt: {self.rebuilt_for}"
 
 
 @dataclasses.dataclass(frozen=True)

@@ -141,7 +141,7 @@ class Replanner:
             self.plans[uav_id] = msgspec.structs.replace(plan, tasks=rest)
             since = self._since.get(uav_id, {})
             self._since[uav_id] = {t.task_id: since[t.task_id] for t in rest if t.task_id in since}
-            self.live.invalidate()  # the session still holds the task
+            self.live.invalidate(f"{uav_id} finished {task_id}")  # the session holds it
             self.bump()
 
     # -- replans -----------------------------------------------------------------
@@ -192,10 +192,10 @@ class Replanner:
         try:
             planned = self.live.replan(build, job.now_s, capacities)
         except pl.PlanningProblemError as exc:  # fleet reports that contradict each other
-            self.live.invalidate()
+            self.live.invalidate("the last problem was refused")
             return Computed(job, {}, error=str(exc))
         except Exception:
-            self.live.invalidate()
+            self.live.invalidate("the last replan failed")
             raise
         elapsed = time.perf_counter() - started
         return Computed(
@@ -204,6 +204,7 @@ class Replanner:
             result=planned.plan,
             elapsed_s=elapsed,
             incremental=planned.incremental,
+            rebuilt_for=planned.rebuilt_for,
         )
 
     def _wire(self, result: pl.Solution, job: ReplanJob, base_s: float) -> dict:
@@ -219,7 +220,7 @@ class Replanner:
         ``prepare`` in a way the result did not see: it is dropped."""
         job = computed.job
         if job.version != self.version:
-            self.live.invalidate()
+            self.live.invalidate("a result the mission had moved past was dropped")
             self.stats.dropped += 1
             return None
         if computed.result is None:
@@ -251,7 +252,7 @@ class Replanner:
                 ]
                 self.store.save_plans(changed)
             except StoreUnavailable:
-                self.live.invalidate()  # the session holds a plan that was not adopted
+                self.live.invalidate("a plan the store could not keep")  # not adopted
                 raise
             for plan in changed:  # every plan out first: the events' disk sync waits
                 self._hold(plan)
@@ -282,14 +283,11 @@ class Replanner:
         if not changed:  # counted in /metrics, not worth an event
             self.stats.unchanged += 1
         else:
-            how = "incremental" if computed.incremental else "rebuilt"
-            if computed.candidate is not None:
-                how = "improved"
             self.events.emit(
                 EventKind.REPLAN,
                 epoch=epoch,
                 detail=f"{job.reason}; {len(changed)} plan(s) changed in "
-                f"{elapsed * 1e3:.1f} ms ({how})",
+                f"{elapsed * 1e3:.1f} ms ({computed.how})",
             )
         action_events = placement_events(job.records, new_tasks, result)
         self.waiting = {u.action_id for u in result.unplaced}

@@ -9,6 +9,8 @@ import asyncio
 import dataclasses
 import random
 
+import msgspec
+
 from ground_station.live_plan import accept, better_by, freeze_broken, frozen_tasks
 from linecrew.bench.ground_station import random_inspection
 from proto import (
@@ -16,6 +18,7 @@ from proto import (
     AgentState,
     AgentStatus,
     EventKind,
+    FlightState,
     InspectTask,
     MonitorAction,
     Point,
@@ -92,6 +95,64 @@ def test_replans_at_one_moment_go_through_the_session_incrementally(gs):
     gs.now += 60  # past the session's window: the fallback rebuilds from the state
     gs.manager.replan("later")
     assert gs.replanner.stats.rebuilds == rebuilds + 1
+
+
+def flown(gs, uav_id: str, metres: float, used_wh: float) -> None:
+    """``uav_id`` reports itself airborne ``metres`` on from home towards
+    its first task (east if it has none), its battery ``used_wh`` lower."""
+    sample = gs.telemetry(uav_id)
+    first = next(iter(gs.latest(uav_id).tasks), None)
+    here = sample.position
+    goal = (
+        first.waypoints[0].position
+        if isinstance(first, InspectTask)
+        else Point(x_m=here.x_m + 1, y_m=here.y_m, z_m=0)
+    )
+    dx, dy = goal.x_m - here.x_m, goal.y_m - here.y_m
+    scale = metres / max(1e-9, (dx * dx + dy * dy) ** 0.5)
+    gs.monitor.on_telemetry(
+        msgspec.structs.replace(
+            sample,
+            position=Point(x_m=here.x_m + dx * scale, y_m=here.y_m + dy * scale, z_m=10.0),
+            battery_wh=sample.battery_wh - used_wh,
+            flight_state=FlightState.FLYING,
+        ),
+        gs.now,
+    )
+
+
+def test_a_uav_flying_its_plan_is_no_reason_to_rebuild_but_one_off_it_is(tmp_path):
+    """At 100 UAVs every new action rebuilt the session (some UAV had always
+    moved) and re-dealt the work of a quarter of the fleet. A UAV that took
+    off and flew towards its first task, its battery within the plan, keeps
+    the session: the next action is inserted; one whose battery fell below
+    what its plan allows by now, or an idle one that moved, rebuilds."""
+    gs = Harness(str(tmp_path / "gs.db"))
+    gs.bring_up(*ALL)
+    rng = random.Random(5)
+    gs.manager.submit(SubmitAction(request_id="a", action=random_inspection(rng)))
+    gs.settle()
+    busy = [p.uav_id for p in gs.sent if p.tasks and isinstance(p.tasks[0], InspectTask)]
+    assert busy
+    stats = gs.replanner.stats
+    gs.now += 3.0
+    flown(gs, busy[0], 12.0, used_wh=0.5)
+    for uav in set(ALL) - {busy[0]}:
+        gs.heartbeat(uav)
+    rebuilds, sent = stats.rebuilds, len(gs.sent)
+    gs.manager.submit(SubmitAction(request_id="b", action=random_inspection(rng)))
+    gs.settle()
+    assert stats.rebuilds == rebuilds  # inserted into the live session
+    assert len(gs.sent) - sent <= 2  # only the UAVs the new work went to hear of it
+    assert all(r.state == ActionState.PLANNED for r in gs.store.actions())
+
+    flown(gs, busy[0], 15.0, used_wh=gs.scenario.fleet.type_of(busy[0]).battery_wh * 0.5)
+    gs.manager.replan("battery far below the plan")
+    assert stats.rebuilds == rebuilds + 1
+    idle = next(u for u in ALL if not any(p.tasks for p in gs.sent if p.uav_id == u))
+    flown(gs, idle, 5.0, used_wh=0.1)
+    gs.manager.replan("an idle UAV moved")
+    assert stats.rebuilds == rebuilds + 2
 
 
 def test_the_margin_decides_between_two_candidates_just_under_and_just_over_it():
