@@ -162,24 +162,25 @@ class AgentReports:
         judged = False
         if isinstance(task, DeliverTask) and outcome.result == OutcomeResult.COMPLETED:
             outcome, judged = self._confirm_drop(outcome, task), True
+        completed = outcome.result == OutcomeResult.COMPLETED
         if task.action_id is not None:
             record = self.book.store.action(task.action_id)
             if record is not None and record.state not in TERMINAL:
                 self._credit(record, task, outcome, f"{outcome.task_id} {outcome.result}")
-        if isinstance(task, MonitorTask) and outcome.result == OutcomeResult.COMPLETED:
+        if isinstance(task, MonitorTask) and completed:
             self._announce_handover(outcome.uav_id, task)
-        if isinstance(task, PickTask | DeliverTask) and outcome.result == OutcomeResult.COMPLETED:
+        if isinstance(task, PickTask | DeliverTask) and completed:
             held = (outcome.tool or task.tool) if isinstance(task, PickTask) else None
             self.monitor.on_handled_tool(outcome.uav_id, held, outcome.stamp_s)
-        self.replanner.finished(outcome.uav_id, outcome.task_id)
+        self.replanner.finished(outcome.uav_id, outcome.task_id, completed)
         if outcome.result == OutcomeResult.FAILED and self._gave_up_safely(task, outcome, judged):
             return
-        if outcome.result != OutcomeResult.COMPLETED:
+        if not completed:
             # the agent dropped the task: if the replan gives it back unchanged
             # (same ids), it must still be sent, with a new epoch
             self.replanner.resend(outcome.uav_id)
         trigger = (
-            outcome.result != OutcomeResult.COMPLETED
+            not completed
             or isinstance(task, ACTION_TASKS)
             or (not isinstance(task, WaitTask) and self._waiting_for_a_uav())
         )

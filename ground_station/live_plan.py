@@ -14,10 +14,12 @@ on a request's path.
   taken off, moved, its battery no lower than the plan has it by the end of
   the step in progress) is no difference: at 100 UAVs, rebuilding for every
   UAV that had moved rebuilt at every new action and re-dealt the work of
-  a quarter of the fleet each time. Anything else (time moved on, a UAV
-  moved off its plan, came back or charged, a task finished, an event the
-  session refuses) rebuilds the session from the current state: the full
-  rebuild is the fallback, with the same planner.
+  a quarter of the fleet each time. An inspection or a delivery completed
+  as planned (the first of the UAV's visits) is applied as a finished task,
+  from where the UAV is then. Anything else (time moved on, a UAV moved off
+  its plan, came back or charged, other work finished, an event the session
+  refuses) rebuilds the session from the current state: the full rebuild is
+  the fallback, with the same planner.
 - **Improvement.** ``improve`` runs the planner's ruin-and-recreate local
   search on the session's state for a fixed number of rounds (deterministic
   for a state and a seed); the candidate is kept only if ``accept`` says so:
@@ -31,18 +33,14 @@ on a request's path.
 from __future__ import annotations
 
 import dataclasses
-import math
+from collections import deque
 from collections.abc import Callable
 
 from ground_station import planner as pl
 from ground_station.planner import improve as improvement
 from ground_station.planner.api import variants
+from ground_station.session_changes import Rebuild, Visited, diff, planned_floor, visits_of
 from proto.plan import InspectTask, MonitorTask, Task, WaitTask
-
-MOVED_M = 1.0
-"""A UAV farther than this from where the session has it has moved: rebuild."""
-ENERGY_TOLERANCE = 0.005
-"""Battery differences below this fraction of capacity are no change."""
 
 Objective = tuple[int, float]
 """(unplaced parts, weight-averaged completion + makespan in seconds)."""
@@ -89,6 +87,7 @@ class LivePlan:
         self._kept: tuple[pl.Session, tuple] | None = None  # a candidate below the margin
         self._kept_objective: Objective = (0, 0.0)
         self._starts = 0  # constructions from scratch tried for this state
+        self._finished: deque[tuple[str, list[Visited]]] = deque()  # (UAV, visits) since
 
     def unusable(self, now_s: float) -> str:
         """Why a replan at ``now_s`` may not use the session ("" if it may)."""
@@ -103,6 +102,17 @@ class LivePlan:
         was dropped)."""
         self.stale = why
         self._new_state()
+
+    def finished(self, uav_id: str, task: Task, completed: bool) -> None:
+        """``task`` ended on ``uav_id`` (from the loop; the worker replans):
+        a completed inspection or delivery is applied at the next replan as
+        finished visits (if they were the UAV's next), a wait is no change;
+        anything else rebuilds."""
+        visits = visits_of(task) if completed else None
+        if visits is None:
+            self.invalidate(f"{uav_id} ended {task.task_id}")
+        elif visits:
+            self._finished.append((uav_id, visits))
 
     def objective(self) -> Objective | None:
         """The live state's objective, if planned."""
@@ -122,6 +132,7 @@ class LivePlan:
             assert self.session is not None and self.course is not None
             problem = build(self.base_s)
             try:
+                self._apply_finished(problem)
                 floors = planned_floor(self.course, now_s - self.base_s)
                 events = diff(self.session.problem, problem, capacities, floors)
                 for event in events:
@@ -129,16 +140,32 @@ class LivePlan:
                 self.incremental += 1
                 plan = self.course = self.session.plan()
                 return Planned(plan, self.base_s, True, len(events), self._objective())
-            except _Rebuild as exc:
+            except Rebuild as exc:
                 why = str(exc)
             except pl.PlanningProblemError as exc:  # rebuild from the state
                 why = f"the session refused the change: {exc}"
+        self._finished.clear()  # the rebuilt session starts from them done
         problem = build(now_s)
         session = pl.Session(problem, self.options)
         self.session, self.base_s, self.stale = session, now_s, ""
         self.rebuilds += 1
         self.course = session.plan()
         return Planned(self.course, now_s, False, 0, self._objective(), why)
+
+    def _apply_finished(self, problem: pl.Problem) -> None:
+        """Apply the visits finished since the last replan (each UAV at its
+        place in ``problem``); ``Rebuild`` if one was not the next planned."""
+        assert self.session is not None
+        uavs = {u.id: u for u in problem.uavs}
+        while self._finished:
+            uav_id, visits = self._finished.popleft()
+            if self.session.next_visits(uav_id)[: len(visits)] != visits or uav_id not in uavs:
+                raise Rebuild(f"{uav_id} finished work the session had not planned next")
+            u = uavs[uav_id]
+            for _ in visits:
+                self.session.apply(
+                    pl.TaskFinished(uav_id=u.id, position_m=u.position_m, energy_wh=u.energy_wh)
+                )
 
     def _objective(self) -> Objective:
         assert self.session is not None
@@ -233,75 +260,6 @@ class LivePlan:
 
     def _new_state(self) -> None:
         self._kept, self._kept_objective, self._starts = None, (0, 0.0), 0
-
-
-class _Rebuild(Exception):
-    """The difference is not one the session can apply."""
-
-
-def planned_floor(plan: pl.Solution, at_s: float) -> dict[str, float]:
-    """For each UAV whose plan has begun by ``at_s`` (planner time), the
-    lowest battery (Wh) the plan has it at by the end of its step in
-    progress: a UAV that has flown its plan so far is at or above it."""
-    out = {}
-    for uav in plan.uavs:
-        begun = [s.energy_after_wh for s in uav.steps if s.start_s <= at_s]
-        if begun:
-            out[uav.uav_id] = min(begun)
-    return out
-
-
-def diff(
-    old: pl.Problem,
-    new: pl.Problem,
-    capacities: dict[str, float],
-    floors: dict[str, float] | None = None,
-) -> list[pl.Event]:
-    """The planner events that turn ``old`` into ``new`` (same time base);
-    raises ``_Rebuild`` when a difference is not such an event (a UAV moved
-    off its course, landed, picked a tool, charged or came back). ``floors``
-    (:func:`planned_floor`) names the UAVs on their course: one of them may
-    have moved and taken off, and used energy down to its floor, as planned."""
-    floors = floors or {}
-    events: list[pl.Event] = []
-    before = {u.id: u for u in old.uavs}
-    if set(before) != {u.id for u in new.uavs} or old.stations != new.stations:
-        raise _Rebuild("the fleet or the stations changed")
-    fleet: list[pl.Event] = []
-    for u in new.uavs:
-        o = before[u.id]
-        if u.available and not o.available:
-            raise _Rebuild(f"{u.id} back")  # it takes its share of the work, as in a full plan
-        if u.available != o.available:
-            fleet.append(pl.UavLost(uav_id=u.id))
-            continue
-        if not u.available:
-            continue
-        tolerance = ENERGY_TOLERANCE * capacities.get(u.id, 1.0)
-        if u.tool != o.tool or u.running != o.running:
-            raise _Rebuild(f"{u.id} took or left a tool or a monitor slot")
-        floor = floors.get(u.id, math.inf)
-        if floor - tolerance <= u.energy_wh <= o.energy_wh + tolerance:
-            if o.airborne and not u.airborne:
-                raise _Rebuild(f"{u.id} landed")  # it charges or ended its flight
-            continue  # on its course: the session's start for it still holds
-        if math.dist(u.position_m, o.position_m) > MOVED_M or u.airborne != o.airborne:
-            raise _Rebuild(f"{u.id} moved off its plan")
-        if o.energy_wh - u.energy_wh > tolerance:
-            fleet.append(pl.BatteryLow(uav_id=u.id, energy_wh=u.energy_wh))
-        elif u.energy_wh - o.energy_wh > tolerance:
-            raise _Rebuild(f"{u.id} charged")  # the session's recharges are wrong now
-    old_actions = {a.id: a for a in old.actions}
-    new_ids = {a.id for a in new.actions}
-    events += [pl.ActionCancelled(action_id=a) for a in old_actions if a not in new_ids]
-    events += [
-        pl.ActionChanged(action=a)
-        for a in new.actions
-        if a.id in old_actions and a != old_actions[a.id]
-    ]
-    events += fleet
-    events += [pl.ActionAdded(action=a) for a in new.actions if a.id not in old_actions]
-    return events
 
 
 # -- hysteresis -----------------------------------------------------------------

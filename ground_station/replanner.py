@@ -127,7 +127,7 @@ class Replanner:
         }
         self.plans[plan.uav_id] = plan
 
-    def finished(self, uav_id: str, task_id: str) -> None:
+    def finished(self, uav_id: str, task_id: str, completed: bool = False) -> None:
         """``task_id`` ended on ``uav_id``: drop it (and what preceded it) from
         the plan held for the UAV, as the agent dropped it from its queue. The
         epoch stays: the agent's queue and this plan still agree."""
@@ -137,11 +137,12 @@ class Replanner:
             return
         ids = [t.task_id for t in plan.tasks]
         if task_id in ids:
-            rest = plan.tasks[ids.index(task_id) + 1 :]
+            at = ids.index(task_id)
+            rest = plan.tasks[at + 1 :]
             self.plans[uav_id] = msgspec.structs.replace(plan, tasks=rest)
             since = self._since.get(uav_id, {})
             self._since[uav_id] = {t.task_id: since[t.task_id] for t in rest if t.task_id in since}
-            self.live.invalidate(f"{uav_id} finished {task_id}")  # the session holds it
+            self.live.finished(uav_id, plan.tasks[at], completed)
             self.bump()
 
     # -- replans -----------------------------------------------------------------
@@ -219,8 +220,7 @@ class Replanner:
         work changed, stored, then sent. None if the mission changed since
         ``prepare`` in a way the result did not see: it is dropped."""
         job = computed.job
-        if job.version != self.version:
-            self.live.invalidate("a result the mission had moved past was dropped")
+        if job.version != self.version:  # the session goes on: the rerun diffs from it
             self.stats.dropped += 1
             return None
         if computed.result is None:

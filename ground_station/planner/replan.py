@@ -102,6 +102,12 @@ class Session:
         """The current plan."""
         return export(self.ctx)
 
+    def next_visits(self, uav_id: str) -> list[tuple[str, str, int | None]]:
+        """The UAV's planned visits in order, as (kind, action id, waypoint
+        index or slot): a ``TaskFinished`` ends the first."""
+        route = self.ctx.routes.get(uav_id)
+        return [(v.kind, v.action_id, v.index) for v in route.tasks] if route else []
+
     # -- helpers ----------------------------------------------------------------
     def _set_problem(self, problem: Problem) -> None:
         self.problem = problem

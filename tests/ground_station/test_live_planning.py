@@ -21,8 +21,10 @@ from proto import (
     FlightState,
     InspectTask,
     MonitorAction,
+    OutcomeResult,
     Point,
     SubmitAction,
+    TaskOutcome,
     Waypoint,
 )
 from tests.ground_station.harness import ALL, Harness
@@ -153,6 +155,54 @@ def test_a_uav_flying_its_plan_is_no_reason_to_rebuild_but_one_off_it_is(tmp_pat
     flown(gs, idle, 5.0, used_wh=0.1)
     gs.manager.replan("an idle UAV moved")
     assert stats.rebuilds == rebuilds + 2
+
+
+def test_an_inspection_completed_as_planned_is_applied_to_the_session_not_rebuilt(tmp_path):
+    """At 100 UAVs every finished task rebuilt the session and re-dealt the
+    work of half the fleet (50-78 plans at once). A completed inspection
+    task, the UAV's next work in the session, is applied as finished visits
+    from where the UAV is: no rebuild, and only a few plans change."""
+    gs = Harness(str(tmp_path / "gs.db"))
+    gs.bring_up(*ALL)
+    rng = random.Random(5)
+    for name in "ab":
+        gs.manager.submit(SubmitAction(request_id=name, action=random_inspection(rng)))
+        gs.settle()
+    plan = next(p for p in reversed(gs.sent) if p.tasks and isinstance(p.tasks[0], InspectTask))
+    task = plan.tasks[0]
+    assert isinstance(task, InspectTask)
+    stats = gs.replanner.stats
+    rebuilds, sent = stats.rebuilds, len(gs.sent)
+    gs.now += 2.0
+    last = task.waypoints[-1].position
+    sample = msgspec.structs.replace(
+        gs.telemetry(plan.uav_id),
+        position=last,
+        battery_wh=gs.telemetry(plan.uav_id).battery_wh - 0.2,
+        flight_state=FlightState.FLYING,
+    )
+    gs.monitor.on_telemetry(sample, gs.now)
+    gs.heartbeat(*(set(ALL) - {plan.uav_id}))
+    gs.manager.reports.on_outcome(
+        TaskOutcome(
+            uav_id=plan.uav_id,
+            task_id=task.task_id,
+            epoch=plan.epoch,
+            result=OutcomeResult.COMPLETED,
+            waypoints_done=[w.index for w in task.waypoints],
+        )
+    )
+    gs.settle()
+    gs.manager.submit(SubmitAction(request_id="c", action=random_inspection(rng)))
+    gs.settle()
+    assert stats.rebuilds == rebuilds, [e.detail for e in gs.events if e.kind == EventKind.REPLAN]
+    assert len(gs.sent) - sent <= 3
+    record = gs.store.action(task.action_id)
+    assert {w.index for w in task.waypoints} <= set(record.waypoints_done)
+    for p in gs.sent[sent:]:  # the finished waypoints are never sent again
+        for t in p.tasks:
+            if isinstance(t, InspectTask) and t.action_id == task.action_id:
+                assert not {w.index for w in t.waypoints} & set(record.waypoints_done)
 
 
 def test_the_margin_decides_between_two_candidates_just_under_and_just_over_it():
