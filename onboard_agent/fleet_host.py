@@ -12,6 +12,10 @@ its own behaviour tree, all on one asyncio loop, sharing the interpreter,
 the imported modules and Zenoh's runtime threads. An agent that fails is
 logged and the others fly on; SIGINT/SIGTERM stops them all. The exit code
 is 1 if any agent failed, 2 for bad flags.
+
+A host runs at a lower CPU priority (``HOST_NICE``): on a real fleet every
+agent has a computer of its own; here a hundred share the ground station's
+machine, and must not make the operator wait (``linecrew bench fleet``).
 """
 
 from __future__ import annotations
@@ -21,6 +25,7 @@ import asyncio
 import concurrent.futures
 import contextvars
 import logging
+import os
 import sys
 from collections.abc import Awaitable, Callable
 
@@ -34,6 +39,9 @@ from proto.errors import LinecrewError
 from proto.scenario import Scenario
 
 log = logging.getLogger(__name__)
+
+HOST_NICE = 5
+"""How much lower than the ground processes a host of simulated agents runs."""
 _current_uav: contextvars.ContextVar[str] = contextvars.ContextVar("uav_id", default="")
 
 
@@ -109,6 +117,7 @@ async def host(
 def main(argv: list[str] | None = None) -> int:
     """Entry point; returns the exit code."""
     args = parser().parse_args(sys.argv[1:] if argv is None else argv)
+    os.nice(HOST_NICE)
     bus_config = start(args, "agents")
     for handler in logging.getLogger().handlers:
         handler.addFilter(_UavTag())

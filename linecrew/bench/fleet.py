@@ -251,7 +251,7 @@ def parser() -> argparse.ArgumentParser:
         help="agents per host (1: a process each)",
     )
     p.add_argument("--duration", type=float, default=20.0, help="idle window measured (s)")
-    p.add_argument("--submits", type=int, default=20, help="inspections submitted per size")
+    p.add_argument("--submits", type=int, default=60, help="inspections submitted per size")
     p.add_argument("--scenario", default="paper", help="the scenario resized to each N")
     p.add_argument("--seed", type=int, default=1)
     p.add_argument("--run-dir", type=pathlib.Path, help="keep each size's logs in DIR/uavs-N")

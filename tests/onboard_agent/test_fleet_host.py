@@ -24,7 +24,7 @@ from linecrew_runtime.bus import Bus, BusConfig
 from linecrew_runtime.process import Shutdown
 from linecrew_runtime.scenarios import load
 from onboard_agent.config import AgentConfig
-from onboard_agent.fleet_host import host
+from onboard_agent.fleet_host import HOST_NICE, host
 from proto import KeySpace, MonitorAction, Role, ScriptedAction
 from tests.e2e.truth import TruthLog
 
@@ -50,6 +50,9 @@ def test_one_host_flies_the_papers_mission_and_stops_on_sigterm(tmp_path):
     with LocalRun(SMALL, options) as run:
         [agents] = [c for c in run.supervisor.children if c.name.startswith("agent")]
         assert agents.name == "agents-1"
+        ground = os.getpriority(os.PRIO_PROCESS, run.supervisor.children[0].popen.pid)
+        host = os.getpriority(os.PRIO_PROCESS, agents.popen.pid)
+        assert host == ground + HOST_NICE  # the operator's processes come first
         truth = TruthLog(run)
         console = Console(file=io.StringIO())
         records, _ = run_mission(
