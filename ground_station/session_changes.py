@@ -58,7 +58,10 @@ def diff(
     raises ``Rebuild`` when a difference is not such an event (a UAV moved
     off its course, landed, picked a tool, charged or came back). ``floors``
     (:func:`planned_floor`) names the UAVs on their course: one of them may
-    have moved and taken off, and used energy down to its floor, as planned."""
+    have moved and taken off, and used energy down to its floor, as planned;
+    the session then has the energy it has now at its start (never more
+    than it has: a route added before its current step is planned on the
+    safe side)."""
     floors = floors or {}
     events: list[pl.Event] = []
     before = {u.id: u for u in old.uavs}
@@ -81,6 +84,8 @@ def diff(
         if floor - tolerance <= u.energy_wh <= o.energy_wh + tolerance:
             if o.airborne and not u.airborne:
                 raise Rebuild(f"{u.id} landed")  # it charges or ended its flight
+            if o.energy_wh - u.energy_wh > tolerance:  # as if it had it at its start: safe side
+                fleet.append(pl.BatteryLow(uav_id=u.id, energy_wh=u.energy_wh))
             continue  # on its course: the session's start for it still holds
         if math.dist(u.position_m, o.position_m) > MOVED_M or u.airborne != o.airborne:
             raise Rebuild(f"{u.id} moved off its plan")
