@@ -12,7 +12,8 @@ on a request's path.
   events: an action added, changed or cancelled, a UAV lost, a battery below
   what the session assumed. A UAV on its course (flying the session's plan:
   taken off, moved, its battery no lower than the plan has it by the end of
-  the step in progress) is no difference: at 100 UAVs, rebuilding for every
+  the step in progress) is no difference but for its battery, taken as what
+  it had at the session's start (the safe side): at 100 UAVs, rebuilding for every
   UAV that had moved rebuilt at every new action and re-dealt the work of
   a quarter of the fleet each time. An inspection or a delivery completed
   as planned (the first of the UAV's visits) is applied as a finished task,
